@@ -1,0 +1,185 @@
+#include "app/cli.hpp"
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <chrono>
+#include <ctime>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "app/context.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "io/output.hpp"
+#include "io/case.hpp"
+
+namespace shroudsim::app {
+namespace {
+
+struct CommonOptions {
+  std::string case_file;
+  std::vector<std::string> sets;
+  std::string out;
+  bool quiet = false;
+  int threads = 0;
+};
+
+void add_common(CLI::App* sub, CommonOptions& o) {
+  sub->add_option("case", o.case_file, "case file (TOML)")->required();
+  sub->add_option("--set", o.sets, "override a case key: KEY=VALUE (dotted key, TOML value); repeatable")
+      ->type_name("KEY=VALUE")
+      ->take_all();
+  sub->add_option("--out", o.out, "result folder (default results/<name>)");
+  sub->add_flag("--quiet,-q", o.quiet, "no progress output");
+  sub->add_option("--threads", o.threads, "worker threads (default: all cores)")->check(CLI::Range(0, 1024));
+}
+
+std::string now_utc() {
+  const auto t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::ostringstream s;
+  s << std::put_time(std::gmtime(&t), "%Y-%m-%dT%H:%M:%SZ");
+  return s.str();
+}
+
+/// Writes run.json: the case as run, versions, stages, statistics, status.
+void write_run_json(const Context& ctx, const std::string& command, const std::string& status,
+                    const std::string& message) {
+  nlohmann::json j = ctx.report.json();
+  j["command"] = command;
+  j["status"] = status;
+  if (!message.empty()) j["message"] = message;
+  j["case_file"] = ctx.config.file.string();
+  j["case"] = nlohmann::json::parse(ctx.config.resolved_json);
+  j["finished_utc"] = now_utc();
+  j["total_seconds"] = ctx.report.total_seconds();
+  j["peak_memory_mib"] = log::peak_memory_mib();
+  j["versions"] = {{"shroudsim", SHROUDSIM_VERSION},
+                   {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
+                                 std::to_string(EIGEN_MINOR_VERSION)},
+                   {"compiler", __VERSION__}};
+  io::write_file_atomic(ctx.out_dir / "run.json", j.dump(2) + "\n");
+}
+
+void print_summary(const Context& ctx, const std::string& command, double seconds) {
+  if (!log::verbose()) return;
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(2) << command << " finished in " << seconds << " s";
+  if (ctx.report.json().contains("stages")) {
+    s << " (";
+    bool first = true;
+    for (const auto& st : ctx.report.json()["stages"]) {
+      s << (first ? "" : ", ") << st["name"].get<std::string>() << " " << st["seconds"].get<double>() << " s"
+        << (st["reused"].get<bool>() ? " reused" : "");
+      first = false;
+    }
+    s << ")";
+  }
+  s << "; results in " << ctx.out_dir.string();
+  log::info(s.str());
+}
+
+}  // namespace
+
+int run_cli(int argc, char** argv) {
+  CLI::App app{"shroudsim: friction damping of shrouded bladed disks (cyclic FE + multiharmonic balance)"};
+  app.require_subcommand(0, 1);
+  bool print_defaults = false, version = false;
+  app.add_flag("--print-defaults", print_defaults, "print a complete commented case file with every default");
+  app.add_flag("--version", version, "print the version");
+
+  struct Sub {
+    const char* name;
+    const char* help;
+    std::function<int(Context&)> run;
+  };
+  const std::vector<Sub> subs = {
+      {"run", "every stage the case asks for, in order, reusing cached stages", cmd_run},
+      {"mesh", "build the sector mesh with gmsh -> meshes/<name>.msh (or check a given mesh)", cmd_mesh},
+      {"modes", "FE assembly, cyclic reduction, modes per harmonic index -> modes.csv", cmd_modes},
+      {"campbell", "frequencies against speed with engine-order lines -> campbell.csv, crossings.csv", cmd_campbell},
+      {"frf", "nonlinear forced response with continuation -> frf.csv", cmd_frf},
+      {"contact", "one contact pair under the prescribed motion of [motion] -> contact.json", cmd_contact},
+      {"study", "the case over the [study] sweep -> one folder per point and study.csv", cmd_study},
+  };
+  std::vector<CommonOptions> options(subs.size());
+  std::vector<CLI::App*> commands;
+  for (std::size_t i = 0; i < subs.size(); ++i) {
+    CLI::App* sub = app.add_subcommand(subs[i].name, subs[i].help);
+    add_common(sub, options[i]);
+    commands.push_back(sub);
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+  if (print_defaults) {
+    std::cout << io::default_case_text();
+    return 0;
+  }
+  if (version) {
+    std::cout << "shroudsim " << SHROUDSIM_VERSION << "\n";
+    return 0;
+  }
+  std::size_t chosen = subs.size();
+  for (std::size_t i = 0; i < subs.size(); ++i)
+    if (commands[i]->parsed()) chosen = i;
+  if (chosen == subs.size()) {
+    std::cerr << app.help();
+    return 2;
+  }
+  const CommonOptions& o = options[chosen];
+  log::set_verbose(!o.quiet);
+  log::Stopwatch clock;
+
+  Context ctx;
+  try {
+    ctx.config = io::load_case(o.case_file, o.sets);
+  } catch (const InputError& e) {
+    std::cerr << "shroudsim: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "shroudsim: error: " << o.case_file << ": " << e.what() << "\n";
+    return 2;
+  }
+  ctx.out_dir = o.out.empty() ? std::filesystem::path("results") / ctx.config.name : std::filesystem::path(o.out);
+  ctx.threads = o.threads;
+  const std::string command = subs[chosen].name;
+
+  int status = 1;
+  std::string state = "failed", message;
+  try {
+    status = subs[chosen].run(ctx);
+    state = status == 0 ? "ok" : status == 3 ? "numerics_failed" : "failed";
+  } catch (const InputError& e) {
+    std::cerr << "shroudsim: error: " << e.what() << "\n";
+    status = 2, state = "bad_input", message = e.what();
+  } catch (const NumericalError& e) {
+    std::cerr << "shroudsim: numerics failed: " << e.what() << "\n";
+    status = 3, state = "numerics_failed", message = e.what();
+  } catch (const std::exception& e) {
+    std::cerr << "shroudsim: error: " << e.what() << "\n";
+    status = 1, state = "failed", message = e.what();
+  }
+  // Bad input leaves the result folder untouched; anything else reports what it did.
+  if (status != 2) {
+    try {
+      write_run_json(ctx, command, state, message);
+    } catch (const std::exception& e) {
+      std::cerr << "shroudsim: error: writing run.json: " << e.what() << "\n";
+      if (status == 0) status = 1;
+    }
+  }
+  if (status == 0) print_summary(ctx, command, clock.seconds());
+  return status;
+}
+
+}  // namespace shroudsim::app

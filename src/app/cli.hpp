@@ -1,0 +1,8 @@
+#pragma once
+// The `shroudsim` command line (CONTRACT.md). Returns the process exit status:
+// 0 done, 1 anything else, 2 bad input (usage, case file, mesh), 3 numerics failed.
+namespace shroudsim::app {
+
+int run_cli(int argc, char** argv);
+
+}  // namespace shroudsim::app

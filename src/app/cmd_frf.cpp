@@ -1,0 +1,14 @@
+// `shroudsim frf`: not built yet (issue 5). Says so and exits 2 until then.
+#include "app/context.hpp"
+#include "core/log.hpp"
+
+#include <iostream>
+
+namespace shroudsim::app {
+
+int cmd_frf(Context&) {
+  std::cerr << "shroudsim: the 'frf' command is not available yet (planned in issue 5)\n";
+  return 2;
+}
+
+}  // namespace shroudsim::app

@@ -1,0 +1,17 @@
+// shroudsim: friction damping of shrouded bladed disks. See README.md.
+#include <exception>
+#include <iostream>
+
+#include "app/cli.hpp"
+
+int main(int argc, char** argv) {
+  try {
+    return shroudsim::app::run_cli(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "shroudsim: error: " << e.what() << "\n";
+    return 1;
+  } catch (...) {
+    std::cerr << "shroudsim: error: unknown failure\n";
+    return 1;
+  }
+}

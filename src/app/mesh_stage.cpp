@@ -1,0 +1,92 @@
+// The mesh stage: a user's mesh read and checked, or the built-in sector generated
+// (and reused while its geometry is unchanged).
+#include <fstream>
+#include <sstream>
+
+#include "app/context.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "io/output.hpp"
+#include "mesh/checks.hpp"
+#include "mesh/msh_reader.hpp"
+#include "mesh/sector_generator.hpp"
+
+namespace shroudsim::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void describe_mesh(Context& ctx, const mesh::Mesh& m, const fs::path& file, bool generated, bool reused) {
+  const mesh::QualityStats q = mesh::element_quality(m);
+  auto& j = ctx.report.section("mesh");
+  j["file"] = file.string();
+  j["generated"] = generated;
+  j["reused"] = reused;
+  j["nodes"] = m.n_nodes();
+  j["elements"] = m.n_elements();
+  j["nodes_per_element"] = m.nodes_per_element();
+  j["dofs"] = m.n_dofs();
+  j["volume_m3"] = q.volume;
+  for (const auto& [name, nodes] : m.node_sets) j["node_sets"][name] = nodes.size();
+  j["cyclic_pairs"] = m.cyclic_pairs.size();
+  j["shroud_pairs"] = m.shroud_pairs.size();
+  j["quality"] = {{"min_mean_ratio", q.min_mean_ratio}, {"mean_mean_ratio", q.mean_mean_ratio},
+                  {"below_0_1", q.below_0_1}, {"min_jacobian_ratio", q.min_jacobian_ratio}};
+  std::ostringstream s;
+  s << "mesh " << file.string() << ": " << m.n_nodes() << " nodes, " << m.n_elements() << " "
+    << m.nodes_per_element() << "-node tetrahedra, " << m.n_dofs() << " DOFs, "
+    << m.cyclic_pairs.size() << " cyclic and " << m.shroud_pairs.size() << " shroud node pairs";
+  log::info(s.str());
+  log::info("mesh " + mesh::describe(q));
+  if (q.min_mean_ratio < 0.05) ctx.report.warn("poor element quality: min mean ratio " + std::to_string(q.min_mean_ratio));
+}
+
+}  // namespace
+
+mesh::Mesh obtain_mesh(Context& ctx) {
+  const io::Case& c = ctx.config;
+  if (c.structure.type != "sector")
+    throw InputError(c.file.string() + ": structure.type = \"" + c.structure.type + "\" has no mesh (meshes are for structure.type = \"sector\")");
+  log::Stopwatch clock;
+  if (!c.structure.mesh.empty()) {
+    mesh::Mesh m;
+    try {
+      m = mesh::read_sector_mesh(c.structure.mesh, {c.structure.sectors, 1e-6});
+    } catch (const InputError& e) {
+      throw InputError(c.locations.at("structure.mesh") + ": structure.mesh: " + e.what());
+    }
+    ctx.report.stage("mesh", clock.seconds(), /*reused=*/false);
+    describe_mesh(ctx, m, c.structure.mesh, false, false);
+    return m;
+  }
+  const mesh::SectorGeometry geometry = io::sector_geometry(c);
+  const fs::path file = fs::path("meshes") / (c.name + ".msh");
+  const fs::path key_file = file.string() + ".key";
+  const std::string key = geometry.fingerprint();
+  bool reused = false;
+  if (fs::exists(file) && fs::exists(key_file) && read_text(key_file) == key) {
+    reused = true;
+  } else {
+    log::info("meshing the sector (gmsh, " + std::to_string(geometry.element_order == 2 ? 10 : 4) +
+              "-node tetrahedra, mesh_size " + io::format_number(geometry.mesh_size) + " m)");
+    fs::remove(key_file);
+    const mesh::GenerateReport r = mesh::generate_sector_mesh(geometry, file, /*verbose=*/false);
+    io::write_file_atomic(key_file, key);
+    ctx.report.section("mesh")["generation_seconds"] = r.seconds;
+  }
+  mesh::Mesh m = mesh::read_sector_mesh(file, {c.structure.sectors, 1e-6});
+  ctx.report.stage("mesh", clock.seconds(), reused);
+  describe_mesh(ctx, m, file, true, reused);
+  auto& j = ctx.report.section("mesh");
+  j["analytic_volume_m3"] = geometry.analytic_volume();
+  return m;
+}
+
+}  // namespace shroudsim::app

@@ -1,0 +1,37 @@
+#include "io/output.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include "core/error.hpp"
+
+namespace shroudsim::io {
+
+void write_file_atomic(const std::filesystem::path& path, const std::string& content) {
+  namespace fs = std::filesystem;
+  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  std::random_device rd;
+  const fs::path tmp = path.string() + ".tmp" + std::to_string(rd() % 1000000);
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    out << content;
+    out.flush();
+    if (!out) {
+      fs::remove(tmp);
+      throw std::runtime_error("writing " + tmp.string() + " failed (disk full?)");
+    }
+  }
+  fs::rename(tmp, path);
+}
+
+std::string format_number(double value) {
+  if (!std::isfinite(value)) throw NumericalError("a non-finite value (NaN or Inf) would reach a result file");
+  char buf[32];
+  const auto res = std::to_chars(buf, buf + sizeof buf, value);
+  return std::string(buf, res.ptr);
+}
+
+}  // namespace shroudsim::io

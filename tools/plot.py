@@ -1,0 +1,54 @@
+#!/usr/bin/python3
+"""Plots of a shroudsim result folder (matplotlib).
+
+usage: tools/plot.py RESULT_DIR
+
+Draws whatever the folder holds results for:
+  modes.csv            -> nd_map.png        (frequency against nodal diameter)
+  campbell.csv         -> campbell.png      (frequency against speed, engine orders, crossings)
+  contact.json         -> contact_loops.png (hysteresis loops of one contact pair)
+  frf.csv              -> frf.png           (nonlinear and linear forced response)
+Exits 0 when it drew everything it found, 1 on a plotting failure, 2 on bad usage.
+"""
+import importlib
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+# (result file, module in tools/plotting, function)
+PLOTS = [
+    ("modes.csv", "plotting.modal_plots", "plot_nd_map"),
+    ("campbell.csv", "plotting.modal_plots", "plot_campbell"),
+    ("contact.json", "plotting.contact_plots", "plot_contact"),
+    ("frf.csv", "plotting.frf_plots", "plot_frf"),
+]
+
+
+def main(argv):
+    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+        print(__doc__, file=sys.stderr)
+        return 2
+    result_dir = argv[1]
+    if not os.path.isdir(result_dir):
+        print(f"plot.py: {result_dir}: no such result folder", file=sys.stderr)
+        return 2
+    import matplotlib
+    matplotlib.use("Agg")
+    status = 0
+    for filename, module, function in PLOTS:
+        if not os.path.exists(os.path.join(result_dir, filename)):
+            continue
+        try:
+            getattr(importlib.import_module(module), function)(result_dir)
+        except ModuleNotFoundError as e:
+            print(f"plot.py: no plotter for {filename} yet ({e})", file=sys.stderr)
+        except Exception as e:  # a broken plot must not hide the others
+            print(f"plot.py: {filename}: {e}", file=sys.stderr)
+            status = 1
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
