@@ -1,0 +1,298 @@
+#include "continuation/arclength.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace shroudsim::continuation {
+
+bool ParametricResidual::solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) {
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(A);
+  d = lu.solve(b);
+  return d.allFinite();
+}
+
+const char* to_string(BranchStatus status) {
+  switch (status) {
+    case BranchStatus::kReachedEnd: return "reached_end";
+    case BranchStatus::kLeftRange: return "left_range";
+    case BranchStatus::kMaxPoints: return "max_points";
+    case BranchStatus::kStepTooSmall: return "step_too_small";
+    case BranchStatus::kStartFailed: return "start_failed";
+    case BranchStatus::kEvaluationFailed: return "evaluation_failed";
+  }
+  return "unknown";
+}
+
+bool ArclengthOptions::validate(std::vector<std::string>* errors) const {
+  std::vector<std::string> e;
+  if (!(lambda_end != lambda_start)) e.push_back("lambda_end != lambda_start");
+  if (!(initial_step > 0)) e.push_back("initial_step > 0");
+  if (!(min_step > 0 && min_step < 1)) e.push_back("0 < min_step < 1");
+  if (!(max_step >= 1)) e.push_back("max_step >= 1");
+  if (!(max_points >= 1)) e.push_back("max_points >= 1");
+  if (!(tolerance > 0)) e.push_back("tolerance > 0");
+  if (!(lambda_scale > 0)) e.push_back("lambda_scale > 0");
+  if (x_scale.size() && (x_scale.array() <= 0).any()) e.push_back("x_scale > 0");
+  if (residual_scale.size() && (residual_scale.array() <= 0).any()) e.push_back("residual_scale > 0");
+  if (errors) *errors = e;
+  return e.empty();
+}
+
+namespace {
+
+/// Scaled view of the residual and its derivatives.
+class Scaled {
+ public:
+  Scaled(ParametricResidual& r, const ArclengthOptions& o, int* evaluations) : r_(r), o_(o), evaluations_(evaluations) {
+    const int n = r.size();
+    xs_ = o.x_scale.size() ? o.x_scale : Eigen::VectorXd::Ones(n);
+    rs_ = o.residual_scale.size() ? o.residual_scale : xs_;
+  }
+  int n() const { return r_.size(); }
+  Eigen::VectorXd to_scaled(const Eigen::VectorXd& x, double lambda) const {
+    Eigen::VectorXd y(n() + 1);
+    y.head(n()) = x.cwiseQuotient(xs_);
+    y[n()] = lambda / o_.lambda_scale;
+    return y;
+  }
+  Eigen::VectorXd x_of(const Eigen::VectorXd& y) const { return y.head(n()).cwiseProduct(xs_); }
+  double lambda_of(const Eigen::VectorXd& y) const { return y[n()] * o_.lambda_scale; }
+
+  /// rs = scaled residual; when Js is not null, Js = d(rs)/d(y_s), n x (n+1).
+  bool evaluate(const Eigen::VectorXd& y, Eigen::VectorXd& rs, Eigen::MatrixXd* Js) {
+    const Eigen::VectorXd x = x_of(y);
+    const double lambda = lambda_of(y);
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    Eigen::VectorXd dl;
+    const bool analytic_lambda = r_.has_lambda_derivative();
+    ++*evaluations_;
+    if (!r_.evaluate(x, lambda, r, Js ? &J : nullptr, Js && analytic_lambda ? &dl : nullptr)) return false;
+    if (!r.allFinite()) return false;
+    rs = r.cwiseQuotient(rs_);
+    if (!Js) return true;
+    if (!analytic_lambda) {
+      const double h = 1e-6 * (std::abs(lambda) + o_.lambda_scale);
+      Eigen::VectorXd rp, rm;
+      evaluations_[0] += 2;
+      if (!r_.evaluate(x, lambda + h, rp, nullptr, nullptr) || !r_.evaluate(x, lambda - h, rm, nullptr, nullptr))
+        return false;
+      dl = (rp - rm) / (2 * h);
+    }
+    Js->resize(n(), n() + 1);
+    Js->leftCols(n()) = rs_.cwiseInverse().asDiagonal() * J * xs_.asDiagonal();
+    Js->col(n()) = dl.cwiseQuotient(rs_) * o_.lambda_scale;
+    return Js->allFinite();
+  }
+
+  ParametricResidual& residual() { return r_; }
+
+ private:
+  ParametricResidual& r_;
+  const ArclengthOptions& o_;
+  int* evaluations_;
+  Eigen::VectorXd xs_, rs_;
+};
+
+/// Unit tangent at y: [Js; row] t = e_{n+1}, oriented along `orient`.
+bool tangent_at(Scaled& s, const Eigen::VectorXd& y, const Eigen::VectorXd& row, const Eigen::VectorXd& orient,
+                Eigen::VectorXd& t) {
+  Eigen::VectorXd rs;
+  Eigen::MatrixXd Js;
+  if (!s.evaluate(y, rs, &Js)) return false;
+  const int n = s.n();
+  Eigen::MatrixXd A(n + 1, n + 1);
+  A.topRows(n) = Js;
+  A.row(n) = row.transpose();
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n + 1);
+  b[n] = 1.0;
+  if (!s.residual().solve_augmented(A, b, t)) return false;
+  const double norm = t.norm();
+  if (!(norm > 0) || !std::isfinite(norm)) return false;
+  t /= norm;
+  if (t.dot(orient) < 0) t = -t;
+  return true;
+}
+
+/// Newton on the augmented system from y (in place). Returns iterations, or -1.
+int corrector(Scaled& s, Eigen::VectorXd& y, const Eigen::VectorXd& t, const Eigen::VectorXd& y_pred,
+              const ArclengthOptions& o, double& final_norm) {
+  const int n = s.n();
+  Eigen::VectorXd rs, b(n + 1), d;
+  Eigen::MatrixXd Js, A(n + 1, n + 1);
+  double first = -1.0;
+  for (int it = 0; it <= o.max_newton_iterations; ++it) {
+    if (!s.evaluate(y, rs, &Js)) return -1;
+    const double constraint = t.dot(y - y_pred);
+    const double norm = std::max(rs.lpNorm<Eigen::Infinity>(), std::abs(constraint));
+    if (first < 0) first = norm;
+    final_norm = norm;
+    if (norm <= o.tolerance) return it;
+    if (it == o.max_newton_iterations || norm > 1e6 * std::max(first, o.tolerance)) return -1;
+    A.topRows(n) = Js;
+    A.row(n) = t.transpose();
+    b.head(n) = -rs;
+    b[n] = -constraint;
+    if (!s.residual().solve_augmented(A, b, d)) return -1;
+    y += d;
+  }
+  return -1;
+}
+
+}  // namespace
+
+int newton_fixed(ParametricResidual& residual, Eigen::VectorXd& x, double lambda, const ArclengthOptions& o,
+                 double* residual_norm) {
+  int evaluations = 0;
+  Scaled s(residual, o, &evaluations);
+  const int n = s.n();
+  Eigen::VectorXd y = s.to_scaled(x, lambda);
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(n + 1);
+  e[n] = 1.0;
+  // Fixing lambda is the augmented system with the constraint row e_lambda.
+  double norm = 0.0;
+  const int it = corrector(s, y, e, y, o, norm);
+  if (residual_norm) *residual_norm = norm;
+  if (it >= 0) x = s.x_of(y);
+  return it;
+}
+
+Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const ArclengthOptions& o,
+             const std::function<void(const BranchPoint&)>& on_point) {
+  Branch branch;
+  Scaled s(residual, o, &branch.residual_evaluations);
+  const int n = s.n();
+  const double direction = o.lambda_end > o.lambda_start ? 1.0 : -1.0;
+  const double lambda_lo = std::min(o.lambda_start, o.lambda_end), lambda_hi = std::max(o.lambda_start, o.lambda_end);
+  const double lambda_slack = 1e-9 * (lambda_hi - lambda_lo);
+  Eigen::VectorXd e_lambda = Eigen::VectorXd::Zero(n + 1);
+  e_lambda[n] = 1.0;
+
+  // Start: Newton at lambda_start.
+  Eigen::VectorXd y = s.to_scaled(x_guess, o.lambda_start);
+  double norm = 0.0;
+  int it = corrector(s, y, e_lambda, y, o, norm);
+  if (it < 0) {
+    branch.status = BranchStatus::kStartFailed;
+    std::ostringstream m;
+    m << "no solution found at the start of the range (lambda = " << o.lambda_start << ", residual " << norm << ")";
+    branch.message = m.str();
+    return branch;
+  }
+  branch.newton_iterations += it;
+  Eigen::VectorXd t;
+  if (!tangent_at(s, y, e_lambda, direction * e_lambda, t)) {
+    branch.status = BranchStatus::kEvaluationFailed;
+    branch.message = "the tangent at the start point could not be computed (singular Jacobian)";
+    return branch;
+  }
+  auto accept = [&](const Eigen::VectorXd& yk, const Eigen::VectorXd& tk, int iters, double step, double rnorm) {
+    BranchPoint p;
+    p.x = s.x_of(yk);
+    p.lambda = s.lambda_of(yk);
+    p.tangent = tk;
+    p.newton_iterations = iters;
+    p.step = step;
+    p.residual_norm = rnorm;
+    branch.points.push_back(p);
+    if (on_point) on_point(branch.points.back());
+  };
+  accept(y, t, it, 0.0, norm);
+
+  double step = o.initial_step;
+  const double min_step = o.min_step * o.initial_step, max_step = o.max_step * o.initial_step;
+  bool retracing = false;
+  int retraced_points = 0;
+  std::vector<Eigen::VectorXd> tangents = {t};  // tangent of each accepted point, for backtracking
+
+  while (static_cast<int>(branch.points.size()) < o.max_points) {
+    const Eigen::VectorXd y_pred = y + step * t;
+    Eigen::VectorXd y_new = y_pred;
+    double rnorm = 0.0;
+    it = corrector(s, y_new, t, y_pred, o, rnorm);
+    Eigen::VectorXd t_new;
+    if (it >= 0 && !tangent_at(s, y_new, t, t, t_new)) it = -1;
+    if (it < 0) {
+      ++branch.rejected_steps;
+      step *= 0.5;
+      if (step < min_step) {
+        branch.status = BranchStatus::kStepTooSmall;
+        std::ostringstream m;
+        m << "the corrector did not converge even with the arclength step reduced to " << step
+          << " (scaled units) at lambda = " << s.lambda_of(y);
+        branch.message = m.str();
+        return branch;
+      }
+      continue;
+    }
+    branch.newton_iterations += it;
+
+    // Turning point: the lambda component of the tangent changes sign.
+    if (t_new[n] * t[n] < 0.0) {
+      if (!retracing && static_cast<int>(branch.points.size()) > 1) {
+        const int drop = std::min<int>(o.turning_backtrack, static_cast<int>(branch.points.size()) - 1);
+        for (int k = 0; k < drop; ++k) {
+          branch.points.pop_back();
+          tangents.pop_back();
+        }
+        y = s.to_scaled(branch.points.back().x, branch.points.back().lambda);
+        t = tangents.back();
+        step = std::max(step / 10.0, min_step);
+        retracing = true;
+        retraced_points = 0;
+        continue;
+      }
+      ++branch.turning_points;
+      retracing = false;
+    }
+    // Steep branch: the x part of the tangent jumps.
+    const double tx_old = t.head(n).norm(), tx_new = t_new.head(n).norm();
+    if (tx_old > 0 && tx_new > o.steep_ratio * tx_old) step = std::min(step, o.initial_step);
+
+    const double used_step = step;
+    y = y_new;
+    t = t_new;
+    tangents.push_back(t);
+    const double lambda = s.lambda_of(y);
+
+    // Leaving the range: the last point is put on the boundary by Newton at fixed lambda.
+    const bool past_end = direction * (lambda - o.lambda_end) > lambda_slack;
+    const bool before_start = direction * (lambda - o.lambda_start) < -lambda_slack;
+    if (past_end || before_start) {
+      const double bound = past_end ? o.lambda_end : o.lambda_start;
+      const BranchPoint& prev = branch.points.back();
+      const double w = (bound - prev.lambda) / (lambda - prev.lambda);
+      Eigen::VectorXd yb = s.to_scaled(prev.x + w * (s.x_of(y) - prev.x), bound);
+      int itb = corrector(s, yb, e_lambda, yb, o, rnorm);
+      if (itb < 0) {  // keep the point outside rather than nothing
+        yb = y;
+        itb = it;
+      } else {
+        branch.newton_iterations += itb;
+      }
+      accept(yb, t, itb, used_step, rnorm);
+      branch.status = past_end ? BranchStatus::kReachedEnd : BranchStatus::kLeftRange;
+      if (before_start) branch.message = "the branch turned back and left the range through its start";
+      return branch;
+    }
+    accept(y, t, it, used_step, rnorm);
+    // A retrace walks at the small step until it passes the turn (or has walked ten times the
+    // dropped stretch, should the turn have been spurious).
+    if (retracing && ++retraced_points > 10 * (o.turning_backtrack + 1)) retracing = false;
+
+    // Step control from the Newton effort.
+    if (retracing) {
+      if (it > o.target_newton_iterations) step = std::max(step * 0.7, min_step);
+    } else if (it <= o.target_newton_iterations / 2) step = std::min(step * 1.5, max_step);
+    else if (it > o.target_newton_iterations) step = std::max(step * 0.7, min_step);
+  }
+  branch.status = BranchStatus::kMaxPoints;
+  std::ostringstream m;
+  m << "stopped after max_points = " << o.max_points << " points at lambda = " << s.lambda_of(y);
+  branch.message = m.str();
+  return branch;
+}
+
+}  // namespace shroudsim::continuation

@@ -1,0 +1,94 @@
+#pragma once
+// Keller pseudo-arclength continuation of R(x, lambda) = 0 (PHYSICS.md section 7).
+//
+// Unknowns y = (x, lambda), scaled as y_s = (x ./ x_scale, lambda / lambda_scale). From a
+// converged point y_k with unit tangent t_k (in scaled variables), the predictor is
+// y_p = y_k + s t_k and the corrector is Newton on the augmented system
+//     R(x, lambda) = 0,   t_k . (y_s - y_p,s) = 0.
+// Step control: grow after few Newton iterations, shrink after many or on failure. When the
+// lambda component of the tangent changes sign (a turning point), the last `turning_backtrack`
+// points are dropped and the turn is retraced at a tenth of the step. When the x part of the
+// tangent grows by more than `steep_ratio` between two points (a steep branch), the step is
+// capped at the initial step.
+//
+// Usage:
+//   MyResidual r;                        // implements ParametricResidual
+//   ArclengthOptions o; o.lambda_start = 100; o.lambda_end = 220; o.x_scale = ...;
+//   const Branch b = trace(r, x_guess, o, [](const BranchPoint& p) { ... });
+//   if (b.status != BranchStatus::kReachedEnd) report(b.message);   // b.points is usable
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace shroudsim::continuation {
+
+/// R(x, lambda): R^n x R -> R^n.
+class ParametricResidual {
+ public:
+  virtual ~ParametricResidual() = default;
+  virtual int size() const = 0;
+  /// r = R(x, lambda); when J is not null, J = dR/dx (n x n); when dr_dlambda is not null,
+  /// dR/dlambda (n) (a residual that cannot give it leaves it untouched and returns
+  /// has_lambda_derivative() = false: the solver then takes a central difference).
+  /// Returns false when R cannot be evaluated there (e.g. non-finite values).
+  virtual bool evaluate(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd& r, Eigen::MatrixXd* J,
+                        Eigen::VectorXd* dr_dlambda) = 0;
+  virtual bool has_lambda_derivative() const { return false; }
+  /// Solves the (n+1) augmented Newton system A d = b. The default is a dense LU;
+  /// a residual with structure (e.g. a low-rank update) may do better.
+  virtual bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d);
+};
+
+struct ArclengthOptions {
+  double lambda_start = 0.0;
+  double lambda_end = 1.0;
+  Eigen::VectorXd x_scale;        ///< typical magnitude of each unknown (> 0); empty: 1
+  Eigen::VectorXd residual_scale; ///< typical magnitude of each residual; empty: x_scale
+  double lambda_scale = 1.0;      ///< unit of lambda in the arclength
+  double initial_step = 0.5;      ///< arclength, scaled units
+  double min_step = 1e-6;         ///< relative to initial_step: stop when the step falls below
+  double max_step = 20.0;         ///< relative to initial_step
+  int max_points = 5000;
+  double tolerance = 1e-8;        ///< on the scaled residual, infinity norm
+  int max_newton_iterations = 15;
+  int target_newton_iterations = 4;  ///< grow the step below, shrink above
+  double steep_ratio = 30.0;      ///< "a" of the steep-branch rule (20 to 40)
+  int turning_backtrack = 2;      ///< points dropped before retracing a turning point
+  bool validate(std::vector<std::string>* errors) const;
+};
+
+struct BranchPoint {
+  Eigen::VectorXd x;
+  double lambda = 0.0;
+  Eigen::VectorXd tangent;        ///< unit tangent (scaled variables), size n+1, lambda last
+  int newton_iterations = 0;
+  double step = 0.0;              ///< arclength step that led here
+  double residual_norm = 0.0;     ///< scaled, infinity norm
+};
+
+enum class BranchStatus { kReachedEnd, kLeftRange, kMaxPoints, kStepTooSmall, kStartFailed, kEvaluationFailed };
+
+/// "reached_end", "left_range", ...
+const char* to_string(BranchStatus status);
+
+struct Branch {
+  std::vector<BranchPoint> points;  ///< in continuation order
+  BranchStatus status = BranchStatus::kReachedEnd;
+  std::string message;              ///< why it stopped, for users
+  int turning_points = 0;           ///< folds passed (after retracing)
+  int newton_iterations = 0;        ///< total
+  int rejected_steps = 0;           ///< corrector failures that shrank the step
+  int residual_evaluations = 0;
+};
+
+/// Newton at fixed lambda from x (updated in place). Returns iterations used, or -1.
+int newton_fixed(ParametricResidual& residual, Eigen::VectorXd& x, double lambda, const ArclengthOptions& options,
+                 double* residual_norm = nullptr);
+
+/// Traces the branch from the solution near x_guess at lambda_start until lambda_end.
+/// on_point is called for every accepted point (may be empty).
+Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const ArclengthOptions& options,
+             const std::function<void(const BranchPoint&)>& on_point = {});
+
+}  // namespace shroudsim::continuation

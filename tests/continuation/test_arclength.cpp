@@ -1,0 +1,157 @@
+// Pseudo-arclength continuation against curves known in closed form.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "continuation/arclength.hpp"
+
+namespace shroudsim::continuation {
+namespace {
+
+/// One-harmonic balance of the Duffing oscillator x'' + 2 z x' + x + g x^3 = F cos(w t),
+/// x = a cos(w t) + b sin(w t), lambda = w. Its amplitude A obeys the closed form
+/// [(1 - w^2 + 3/4 g A^2)^2 + (2 z w)^2] A^2 = F^2, with two folds for a hardening spring.
+class Duffing : public ParametricResidual {
+ public:
+  Duffing(double z, double g, double f) : z_(z), g_(g), f_(f) {}
+  int size() const override { return 2; }
+  bool has_lambda_derivative() const override { return true; }
+  bool evaluate(const Eigen::VectorXd& x, double w, Eigen::VectorXd& r, Eigen::MatrixXd* J,
+                Eigen::VectorXd* dl) override {
+    const double a = x[0], b = x[1], a2 = a * a + b * b, k = 1 - w * w + 0.75 * g_ * a2;
+    r.resize(2);
+    r << k * a + 2 * z_ * w * b - f_, k * b - 2 * z_ * w * a;
+    if (J) {
+      J->resize(2, 2);
+      (*J) << k + 1.5 * g_ * a * a, 2 * z_ * w + 1.5 * g_ * a * b, 1.5 * g_ * a * b - 2 * z_ * w, k + 1.5 * g_ * b * b;
+    }
+    if (dl) {
+      dl->resize(2);
+      (*dl) << -2 * w * a + 2 * z_ * b, -2 * w * b - 2 * z_ * a;
+    }
+    return true;
+  }
+  /// Relative residual of the closed-form amplitude relation.
+  double closed_form_error(const BranchPoint& p) const {
+    const double a2 = p.x.squaredNorm(), w = p.lambda, k = 1 - w * w + 0.75 * g_ * a2;
+    return std::abs((k * k + 4 * z_ * z_ * w * w) * a2 - f_ * f_) / (f_ * f_);
+  }
+
+ private:
+  double z_, g_, f_;
+};
+
+TEST(Arclength, TracesBothFoldsOfTheDuffingResponse) {
+  Duffing duffing(/*z=*/0.01, /*g=*/1.0, /*f=*/0.01);
+  ArclengthOptions o;
+  o.lambda_start = 0.5;
+  o.lambda_end = 1.5;
+  o.x_scale = Eigen::VectorXd::Constant(2, 0.05);
+  o.initial_step = 0.02;
+  o.tolerance = 1e-10;
+  const Branch b = trace(duffing, Eigen::VectorXd::Zero(2), o);
+  ASSERT_EQ(b.status, BranchStatus::kReachedEnd) << b.message;
+  EXPECT_EQ(b.turning_points, 2);
+  EXPECT_DOUBLE_EQ(b.points.back().lambda, 1.5);
+  // Newton converged to 1e-10 on residuals of size ~f; the closed form is the same equation
+  // squared, so its relative error is of the order tolerance * x_scale / f.
+  constexpr double kClosedFormTol = 1e-8;
+  double peak = 0.0;
+  for (const auto& p : b.points) {
+    EXPECT_LT(duffing.closed_form_error(p), kClosedFormTol) << "w = " << p.lambda;
+    peak = std::max(peak, p.x.norm());
+  }
+  // The peak lies on the backbone w^2 = 1 + 3/4 g A^2 with A ~ F / (2 z w): traced, not jumped.
+  EXPECT_NEAR(peak, 0.01 / (2 * 0.01 * std::sqrt(1 + 0.75 * peak * peak)), 0.01 * peak);
+  // The frequency is not monotonic: it goes back between the folds.
+  int reversals = 0;
+  for (std::size_t i = 2; i < b.points.size(); ++i) {
+    const double d1 = b.points[i - 1].lambda - b.points[i - 2].lambda, d2 = b.points[i].lambda - b.points[i - 1].lambda;
+    reversals += d1 * d2 < 0;
+  }
+  EXPECT_EQ(reversals, 2);
+}
+
+/// x^2 + lambda^2 = 1: from (1, 0) the branch turns at lambda = 1 and comes back to 0.
+class Circle : public ParametricResidual {
+ public:
+  int size() const override { return 1; }
+  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd*) override {
+    r = Eigen::VectorXd::Constant(1, x[0] * x[0] + l * l - 1.0);
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, 2 * x[0]);
+    return true;
+  }
+};
+
+TEST(Arclength, PassesATurningPointAndReportsLeavingTheRange) {
+  Circle circle;
+  ArclengthOptions o;
+  o.lambda_start = 0.0;
+  o.lambda_end = 2.0;
+  o.initial_step = 0.05;
+  const Branch b = trace(circle, Eigen::VectorXd::Constant(1, 0.9), o);
+  EXPECT_EQ(b.status, BranchStatus::kLeftRange) << b.message;
+  EXPECT_EQ(b.turning_points, 1);
+  EXPECT_NEAR(b.points.front().x[0], 1.0, 1e-8);
+  EXPECT_NEAR(b.points.back().x[0], -1.0, 1e-6);
+  for (const auto& p : b.points) EXPECT_NEAR(p.x[0] * p.x[0] + p.lambda * p.lambda, 1.0, 1e-7);
+  // The turn was retraced at a tenth of the step: some step is a tenth of the largest before it.
+  bool retraced = false;
+  double largest = 0.0;
+  for (std::size_t i = 1; i < b.points.size(); ++i) {
+    retraced |= b.points[i].step <= 0.1 * largest * (1 + 1e-12);
+    largest = std::max(largest, b.points[i].step);
+  }
+  EXPECT_TRUE(retraced);
+}
+
+/// x^2 + 1 = 0 has no real solution.
+class NoSolution : public ParametricResidual {
+ public:
+  int size() const override { return 1; }
+  bool evaluate(const Eigen::VectorXd& x, double, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd*) override {
+    r = Eigen::VectorXd::Constant(1, x[0] * x[0] + 1.0);
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, 2 * x[0]);
+    return true;
+  }
+};
+
+TEST(Arclength, ReportsFailuresInsteadOfHidingThem) {
+  NoSolution none;
+  ArclengthOptions o;
+  const Branch b = trace(none, Eigen::VectorXd::Constant(1, 0.3), o);
+  EXPECT_EQ(b.status, BranchStatus::kStartFailed);
+  EXPECT_TRUE(b.points.empty());
+  EXPECT_NE(b.message.find("no solution"), std::string::npos);
+
+  Duffing duffing(0.01, 1.0, 0.01);
+  o.lambda_start = 0.5;
+  o.lambda_end = 1.5;
+  o.max_points = 7;
+  const Branch capped = trace(duffing, Eigen::VectorXd::Zero(2), o);
+  EXPECT_EQ(capped.status, BranchStatus::kMaxPoints);
+  EXPECT_EQ(capped.points.size(), 7u);
+  EXPECT_NE(capped.message.find("max_points"), std::string::npos);
+}
+
+TEST(Arclength, FiniteDifferenceInLambdaGivesTheSameCurve) {
+  // Without dR/dlambda the solver differentiates in lambda itself; the curve is the same.
+  class DuffingNoLambda : public Duffing {
+   public:
+    using Duffing::Duffing;
+    bool has_lambda_derivative() const override { return false; }
+  } fd(0.01, 1.0, 0.01);
+  Duffing exact(0.01, 1.0, 0.01);
+  ArclengthOptions o;
+  o.lambda_start = 0.5;
+  o.lambda_end = 1.5;
+  o.x_scale = Eigen::VectorXd::Constant(2, 0.05);
+  o.initial_step = 0.02;
+  const Branch a = trace(exact, Eigen::VectorXd::Zero(2), o), b = trace(fd, Eigen::VectorXd::Zero(2), o);
+  ASSERT_EQ(b.status, BranchStatus::kReachedEnd);
+  EXPECT_EQ(a.turning_points, b.turning_points);
+  for (const auto& p : b.points) EXPECT_LT(exact.closed_form_error(p), 1e-6);
+}
+
+}  // namespace
+}  // namespace shroudsim::continuation
