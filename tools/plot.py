@@ -8,6 +8,8 @@ Draws whatever the folder holds results for:
   campbell.csv         -> campbell.png      (frequency against speed, engine orders, crossings)
   contact.json         -> contact_loops.png (hysteresis loops of one contact pair)
   frf.csv              -> frf.png           (nonlinear and linear forced response)
+  loops.csv            -> loops.png         (contact loops at the peak)
+  study.csv            -> study.png         (peak amplitude and frequency over a sweep)
 Exits 0 when it drew everything it found, 1 on a plotting failure, 2 on bad usage.
 """
 import importlib
@@ -23,6 +25,7 @@ PLOTS = [
     ("campbell.csv", "plotting.modal_plots", "plot_campbell"),
     ("contact.json", "plotting.contact_plots", "plot_contact"),
     ("frf.csv", "plotting.frf_plots", "plot_frf"),
+    ("study.csv", "plotting.study_plots", "plot_study"),
 ]
 
 

@@ -152,6 +152,7 @@ int run_cli(int argc, char** argv) {
   }
   ctx.out_dir = o.out.empty() ? std::filesystem::path("results") / ctx.config.name : std::filesystem::path(o.out);
   ctx.threads = o.threads;
+  ctx.overrides = o.sets;
   const std::string command = subs[chosen].name;
 
   int status = 1;

@@ -1,14 +1,220 @@
-// `shroudsim frf`: not built yet (issue 5). Says so and exits 2 until then.
-#include "app/context.hpp"
-#include "core/log.hpp"
+// `shroudsim frf CASE`: nonlinear forced response by multiharmonic balance with
+// pseudo-arclength continuation -> frf.csv, loops.csv, run.json statistics.
+#include <cmath>
+#include <iomanip>
+#include <memory>
+#include <numbers>
+#include <sstream>
 
-#include <iostream>
+#include "app/context.hpp"
+#include "app/forced_stage.hpp"
+#include "app/modal_stage.hpp"
+#include "continuation/arclength.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "forced/reduced_equations.hpp"
+#include "frf/lumped.hpp"
+#include "hbm/contact_evaluator.hpp"
+#include "io/output.hpp"
 
 namespace shroudsim::app {
+namespace {
 
-int cmd_frf(Context&) {
-  std::cerr << "shroudsim: the 'frf' command is not available yet (planned in issue 5)\n";
-  return 2;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+contact::PairParameters pair_of(const io::ContactSection& c, const io::ContactElement* e) {
+  contact::PairParameters p;
+  p.friction_coefficient = e && e->friction_coefficient ? *e->friction_coefficient : c.friction_coefficient;
+  p.normal_stiffness = e && e->normal_stiffness ? *e->normal_stiffness : c.normal_stiffness;
+  p.tangential_stiffness = e && e->tangential_stiffness ? *e->tangential_stiffness : c.tangential_stiffness;
+  p.normal_preload = e && e->normal_preload ? *e->normal_preload : c.normal_preload;
+  return p;
+}
+
+}  // namespace
+
+ForcedModel make_lumped_model(const io::Case& c) {
+  ForcedModel model;
+  std::vector<frf::LumpedContact> contacts;
+  for (const auto& e : c.contact.elements) {
+    frf::LumpedContact lc;
+    lc.dof = {e.x_dof, e.y_dof, e.z_dof};
+    lc.other = {e.other_x_dof, e.other_y_dof, e.other_z_dof};
+    lc.frame_angle = (e.frame_angle_deg ? *e.frame_angle_deg : c.contact.frame_angle_deg) * kDeg;
+    contacts.push_back(lc);
+    model.pairs.push_back(pair_of(c.contact, &e));
+  }
+  if (contacts.empty())
+    throw InputError(c.locations.at("contact.elements") + ": contact.elements: a lumped forced response needs at least one [[contact.elements]]");
+  model.linear = std::make_unique<frf::LumpedLinearPart>(c.structure.mass, c.structure.stiffness, c.structure.damping,
+                                                         contacts, c.excitation.dof, c.excitation.force[0], c.response.dof);
+  return model;
+}
+
+hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
+  hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = c.hbm.harmonics;
+  o.n_time_samples = c.hbm.time_samples;
+  o.law.model = *contact::parse_model(c.contact.model);
+  o.law.update = *contact::parse_update(c.contact.tangential_update);
+  o.jacobian = *hbm::parse_jacobian(c.hbm.jacobian);
+  o.threads = threads;
+  if (o.law.model == contact::Model::one_d_exact && o.n_harmonics != 1)
+    throw InputError(c.locations.at("hbm.harmonics") + ": hbm.harmonics = " + std::to_string(c.hbm.harmonics) +
+                     " violates: harmonics = 1 for contact.model = \"1d_exact\" (the time-continuous single-harmonic law)");
+  std::vector<std::string> errors;
+  if (!o.validate(&errors)) throw InputError(c.file.string() + ": " + errors.front());
+  return o;
+}
+
+int cmd_frf(Context& ctx) {
+  const io::Case& c = ctx.config;
+  if (c.hbm.harmonics_auto || c.hbm.time_samples_auto)
+    throw InputError(c.locations.at("hbm.harmonics") + ": hbm.harmonics/time_samples = \"auto\" is not available yet (planned in issue 6)");
+  log::Stopwatch clock;
+  ForcedModel model = c.structure.type == "lumped" ? make_lumped_model(c) : make_sector_model(ctx);
+  for (const auto& p : model.pairs) {
+    std::vector<std::string> errors;
+    if (!p.validate(*contact::parse_model(c.contact.model), &errors)) throw InputError(c.file.string() + ": " + errors.front());
+  }
+  const hbm::ContactEvaluatorOptions eo = evaluator_options(c, ctx.threads);
+  hbm::ContactEvaluator evaluator(eo, model.pairs);
+  forced::ReducedEquations equations(*model.linear, evaluator);
+
+  // Scaled variables: the free linear contact motion over the range sets the unit of W,
+  // so that a resonance peak spans some tens of arclength units (PHYSICS.md section 7).
+  const auto& cn = c.continuation;
+  double motion = 0.0;
+  for (int i = 0; i <= 40; ++i) {
+    const double f = cn.frequency_start_hz + (cn.frequency_end_hz - cn.frequency_start_hz) * i / 40.0;
+    motion = std::max(motion, equations.linear_motion(f).lpNorm<Eigen::Infinity>());
+  }
+  double contact_scale = 0.0;
+  for (const auto& p : model.pairs)
+    contact_scale = std::max({contact_scale, p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness,
+                              std::abs(p.normal_preload) / p.normal_stiffness});
+  const double x_scale = motion > 0 ? motion / 20.0 : std::max(contact_scale, 1e-12);
+  continuation::ArclengthOptions ao;
+  ao.lambda_start = cn.frequency_start_hz;
+  ao.lambda_end = cn.frequency_end_hz;
+  ao.x_scale = Eigen::VectorXd::Constant(equations.size(), x_scale);
+  ao.initial_step = cn.initial_step;
+  // At least ~200 points over the range, whatever the step growth: a peak is never stepped over.
+  ao.max_step = std::max(1.0, std::abs(cn.frequency_end_hz - cn.frequency_start_hz) / (200.0 * cn.initial_step));
+  ao.max_points = cn.max_points;
+  ao.tolerance = c.hbm.tolerance;
+
+  std::vector<forced::PointResult> results;
+  std::vector<int> iterations;
+  log::info("frf: " + model.linear->describe() + ", " + std::to_string(evaluator.n_pairs()) + " contact pairs, " +
+            std::to_string(equations.size()) + " unknowns (H = " + std::to_string(c.hbm.harmonics) +
+            ", N = " + std::to_string(c.hbm.time_samples) + ", " + c.contact.model + ", " + c.hbm.jacobian + " Jacobian)");
+  // Start: Newton from the stuck-contact solution; where it fails (Newton cycling between
+  // contact states), continuation in the excitation level from the preload-only state.
+  Eigen::VectorXd start = equations.stuck_solution(ao.lambda_start);
+  if (continuation::newton_fixed(equations, start, ao.lambda_start, ao) < 0) {
+    start = equations.stuck_solution(ao.lambda_start);
+    const continuation::Branch h = equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start);
+    ctx.report.section("frf")["start_homotopy_points"] = h.points.size();
+    if (h.status != continuation::BranchStatus::kReachedEnd)
+      throw NumericalError("no solution at the start frequency " + io::format_number(ao.lambda_start) +
+                           " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
+                           h.message);
+    log::info("frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) + " points)");
+  }
+  const continuation::Branch branch = continuation::trace(equations, start, ao,
+                                                          [&](const continuation::BranchPoint& p) {
+    results.push_back(equations.analyse(p.x, p.lambda));
+    iterations.push_back(p.newton_iterations);
+    if (log::verbose()) {
+      std::ostringstream s;
+      s << "frf: point " << results.size() << "  f = " << std::fixed << std::setprecision(3) << p.lambda
+        << " Hz  amplitude = " << std::scientific << std::setprecision(4) << results.back().amplitude
+        << " m  step " << std::defaultfloat << std::setprecision(3) << p.step << "  newton " << p.newton_iterations;
+      log::info(s.str());
+    }
+  });
+  // Points dropped when a turning point was retraced are removed from the results as well.
+  std::vector<forced::PointResult> kept;
+  std::vector<int> kept_it;
+  for (const auto& p : branch.points)
+    for (std::size_t i = results.size(); i-- > 0;)
+      if (results[i].frequency_hz == p.lambda) {
+        kept.push_back(results[i]);
+        kept_it.push_back(p.newton_iterations);
+        break;
+      }
+
+  std::ostringstream csv;
+  csv << "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations";
+  for (int n = 0; n <= c.hbm.harmonics; ++n) csv << ",h" << n << "_m";
+  csv << "\n";
+  double max_energy_error = 0.0, peak = 0.0, peak_f = 0.0;
+  std::size_t peak_index = 0;
+  int unconverged = 0;
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const auto& r = kept[i];
+    csv << io::format_number(r.frequency_hz) << "," << io::format_number(r.amplitude) << ","
+        << io::format_number(r.linear_amplitude) << "," << kept_it[i];
+    for (double a : r.harmonic_amplitudes) csv << "," << io::format_number(a);
+    csv << "\n";
+    max_energy_error = std::max(max_energy_error, r.energy_error);
+    unconverged += r.unconverged_pairs;
+    if (r.amplitude > peak) peak = r.amplitude, peak_f = r.frequency_hz, peak_index = i;
+  }
+  io::write_file_atomic(ctx.out_dir / "frf.csv", csv.str());
+
+  // Hysteresis loops of every pair (at most 10) at the peak.
+  if (!branch.points.empty()) {
+    std::ostringstream loops;
+    loops << "pair,sample,x_m,y_m,z_m,tx_n,ty_n,n_n\n";
+    const Eigen::VectorXd& w = branch.points[peak_index].x;
+    const int block = evaluator.pair_layout().size();
+    for (int p = 0; p < std::min(evaluator.n_pairs(), 10); ++p) {
+      hbm::PairDetail d;
+      evaluator.evaluate_pair(p, w.segment(p * block, block), d, false);
+      for (Eigen::Index l = 0; l < d.w.rows(); ++l) {
+        loops << p << "," << l;
+        for (int k = 0; k < 3; ++k) loops << "," << io::format_number(d.w(l, k));
+        for (int k = 0; k < 3; ++k) loops << "," << io::format_number(d.f(l, k));
+        loops << "\n";
+      }
+    }
+    io::write_file_atomic(ctx.out_dir / "loops.csv", loops.str());
+  }
+
+  auto& j = ctx.report.section("frf");
+  j["points"] = kept.size();
+  j["status"] = continuation::to_string(branch.status);
+  j["message"] = branch.message;
+  j["turning_points"] = branch.turning_points;
+  j["newton_iterations"] = branch.newton_iterations;
+  j["rejected_steps"] = branch.rejected_steps;
+  j["residual_evaluations"] = branch.residual_evaluations;
+  j["unknowns"] = equations.size();
+  j["contact_pairs"] = evaluator.n_pairs();
+  j["x_scale_m"] = x_scale;
+  j["max_energy_balance_error"] = max_energy_error;
+  j["peak_amplitude_m"] = peak;
+  j["peak_frequency_hz"] = peak_f;
+  j["unconverged_periodic_pairs"] = unconverged;
+  ctx.report.stage("frf", clock.seconds());
+  if (unconverged > 0)
+    ctx.report.warn(std::to_string(unconverged) + " contact evaluations did not reach a periodic state within the period cap");
+  if (max_energy_error > 1e-3) ctx.report.warn("energy balance error up to " + std::to_string(max_energy_error));
+  std::ostringstream s;
+  s << "frf: " << kept.size() << " points, peak " << std::scientific << std::setprecision(4) << peak << " m at "
+    << std::defaultfloat << std::setprecision(6) << peak_f << " Hz, " << branch.turning_points << " turning points, "
+    << branch.newton_iterations << " Newton iterations, max energy-balance error " << std::setprecision(2)
+    << max_energy_error;
+  log::info(s.str());
+  draw_plots(ctx);
+  if (branch.status != continuation::BranchStatus::kReachedEnd) {
+    ctx.report.section("frf")["failed"] = true;
+    throw NumericalError("continuation stopped: " + branch.message + " (" + std::to_string(kept.size()) +
+                         " points written to frf.csv)");
+  }
+  return 0;
 }
 
 }  // namespace shroudsim::app

@@ -1,14 +1,398 @@
-// `shroudsim modes`: not built yet (issue 3). Says so and exits 2 until then.
-#include "app/context.hpp"
-#include "core/log.hpp"
+// `shroudsim modes`: FE assembly, cyclic reduction and modes per harmonic index ->
+// modes.csv (the nodal diameter map), modes.vtu, nd_map.png. Also the modal stage shared
+// with `campbell` and the forced response (app/modal_stage.hpp).
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <mutex>
+#include <sstream>
+#include <thread>
 
-#include <iostream>
+#include "app/context.hpp"
+#include "app/modal_stage.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "fe/assembly.hpp"
+#include "fe/fingerprint.hpp"
+#include "io/output.hpp"
+#include "modal/cache.hpp"
+#include "modal/harmonic.hpp"
+
+#ifndef SHROUDSIM_SOURCE_DIR
+#define SHROUDSIM_SOURCE_DIR "."
+#endif
 
 namespace shroudsim::app {
+namespace {
 
-int cmd_modes(Context&) {
-  std::cerr << "shroudsim: the 'modes' command is not available yet (planned in issue 3)\n";
-  return 2;
+namespace fs = std::filesystem;
+
+std::string location(const io::Case& c, const std::string& key) {
+  auto it = c.locations.find(key);
+  return it != c.locations.end() ? it->second : c.file.string();
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+// Version tags: bump when the meaning of a cached entry changes.
+constexpr const char* kMatricesVersion = "fe-km/1";
+constexpr const char* kModesVersion = "modes/1";
+
+std::string matrices_key(const mesh::Mesh& m, const fe::Material& mat) {
+  fe::Hasher h;
+  h.add(std::string(kMatricesVersion));
+  fe::hash_into(h, m);
+  fe::hash_into(h, mat);
+  return h.hex();
+}
+
+std::string modes_key(const std::string& km_key, int h, const modal::ModalOptions& o) {
+  fe::Hasher hs;
+  hs.add(std::string(kModesVersion));
+  hs.add(km_key);
+  hs.add(h);
+  hs.add(o.modes);
+  hs.add(o.shift);
+  hs.add(o.tolerance);
+  hs.add(o.residual_tolerance);
+  return hs.hex();
+}
+
+// Modes of one canonical harmonic index (h <= Nb/2), solved or from the cache.
+struct HarmonicOutcome {
+  modal::ModalResult result;
+  bool reused = false;
+  double seconds = 0.0;
+};
+
+}  // namespace
+
+const cyclic::CyclicSector& ModalModel::cyclic() {
+  if (!cyclic_) cyclic_ = std::make_unique<cyclic::CyclicSector>(mesh, km);
+  return *cyclic_;
+}
+
+modal::StiffnessFactor ModalModel::stiffness_factor(int h) {
+  auto it = factors.find(h);
+  if (it != factors.end()) return it->second;
+  const int nb = mesh.sectors;
+  auto conj = factors.find((nb - h) % nb);
+  if (conj != factors.end()) return factors[h] = conj->second.conjugate();
+  return factors[h] = modal::factor_harmonic_stiffness(cyclic(), h, options.factor_method);
+}
+
+std::vector<int> modal_harmonic_indices(const io::Case& c) {
+  const int nb = c.structure.sectors;
+  std::vector<int> hs;
+  if (c.modal.all_harmonic_indices) {
+    for (int h = 0; h < nb; ++h) hs.push_back(h);
+    return hs;
+  }
+  for (int h : c.modal.harmonic_indices) {
+    if (h < 0 || h >= nb)
+      throw InputError(location(c, "modal.harmonic_indices") + ": modal.harmonic_indices contains " +
+                       std::to_string(h) + ", which violates: 0 <= h < structure.sectors = " + std::to_string(nb));
+    hs.push_back(h);
+  }
+  std::sort(hs.begin(), hs.end());
+  hs.erase(std::unique(hs.begin(), hs.end()), hs.end());
+  return hs;
+}
+
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices) {
+  const io::Case& c = ctx.config;
+  ModalModel model;
+  model.mesh = obtain_mesh(ctx);
+  const int nb = model.mesh.sectors > 0 ? model.mesh.sectors : c.structure.sectors;
+  model.mesh.sectors = nb;
+  model.material = {c.material.youngs_modulus, c.material.poisson_ratio, c.material.density};
+  if (!model.material.valid())
+    throw InputError(location(c, "material.youngs_modulus") +
+                     ": [material] violates: youngs_modulus > 0, -1 < poisson_ratio < 0.5, density > 0");
+  model.options.modes = c.modal.modes;
+  std::vector<std::string> errors;
+  if (!model.options.validate(&errors)) throw InputError(location(c, "modal.modes") + ": modal." + errors.front());
+
+  const fs::path cache_dir = c.directory / ".cache";
+  auto& report = ctx.report.section("modal");
+  report["cache_dir"] = cache_dir.string();
+  report["sectors"] = nb;
+  report["modes_per_harmonic_index"] = model.options.modes;
+
+  // K and M.
+  log::Stopwatch clock;
+  const std::string km_key = matrices_key(model.mesh, model.material);
+  const fs::path km_file = cache_dir / ("km-" + km_key + ".bin");
+  bool km_reused = false;
+  if (auto cached = modal::load_matrices(km_file);
+      cached && cached->K.rows() == model.mesh.n_dofs() && cached->M.rows() == model.mesh.n_dofs()) {
+    model.km = std::move(*cached);
+    km_reused = true;
+  } else {
+    model.km = fe::assemble(model.mesh, model.material, ctx.threads);
+    try {
+      modal::save_matrices(km_file, model.km);
+    } catch (const std::exception& e) {
+      ctx.report.warn(std::string("could not cache K and M: ") + e.what());
+    }
+  }
+  const double km_seconds = clock.seconds();
+  ctx.report.stage("assembly", km_seconds, km_reused);
+  report["matrices"] = {{"key", km_key}, {"reused", km_reused}, {"seconds", km_seconds},
+                        {"dofs", model.mesh.n_dofs()}, {"stored_entries_K", model.km.K.nonZeros()}};
+  log::info(std::string(km_reused ? "reused" : "assembled") + " K and M: " + std::to_string(model.mesh.n_dofs()) +
+            " DOFs, " + std::to_string(model.km.K.nonZeros()) + " stored entries (" + fixed(km_seconds, 2) + " s)");
+
+  // Canonical harmonic indices: h and Nb - h share the solve of min(h, Nb - h).
+  std::vector<int> canonical;
+  for (int h : harmonic_indices) canonical.push_back(std::min(h, (nb - h) % nb));
+  std::sort(canonical.begin(), canonical.end());
+  canonical.erase(std::unique(canonical.begin(), canonical.end()), canonical.end());
+
+  clock.restart();
+  std::map<int, HarmonicOutcome> outcome;
+  std::vector<int> to_solve;
+  for (int h : canonical) {
+    const fs::path f = cache_dir / ("modes-" + modes_key(km_key, h, model.options) + ".bin");
+    auto cached = modal::load_basis(f);
+    if (cached && cached->harmonic_index == h && cached->size() == model.options.modes) {
+      HarmonicOutcome& o = outcome[h];
+      o.reused = true;
+      o.result.basis = std::move(*cached);
+      o.result.report.method = "cache";
+    } else {
+      to_solve.push_back(h);
+    }
+  }
+  if (!to_solve.empty()) {
+    const cyclic::CyclicSector& sector = model.cyclic();
+    report["reduced_dofs"] = sector.n_reduced();
+    // Harmonic indices are independent: solve them in parallel (each worker holds one
+    // factorization; CHOLMOD, Spectra and Eigen objects are not shared).
+    const int workers = std::clamp(ctx.threads > 0 ? ctx.threads : static_cast<int>(std::thread::hardware_concurrency()),
+                                   1, static_cast<int>(to_solve.size()));
+    std::atomic<std::size_t> next{0};
+    std::mutex lock;
+    auto work = [&] {
+      for (std::size_t i = next++; i < to_solve.size(); i = next++) {
+        const int h = to_solve[i];
+        log::Stopwatch watch;
+        HarmonicOutcome o;
+        try {
+          o.result = modal::solve_harmonic(sector, h, model.options);
+        } catch (const std::exception& e) {
+          o.result.report.status = modal::ModalStatus::NotConverged;
+          o.result.report.message = e.what();
+        }
+        o.seconds = watch.seconds();
+        const auto& r = o.result.report;
+        std::string line = "modes h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
+        if (r.ok()) {
+          const Eigen::VectorXd f = o.result.basis.frequency_hz();
+          line += std::to_string(f.size()) + " modes, " + fixed(f(0), 2) + " .. " + fixed(f(f.size() - 1), 2) +
+                  " Hz (" + r.method + ", factor " + fixed(r.factor_seconds, 2) + " s, Lanczos " +
+                  fixed(r.solve_seconds, 2) + " s, " + std::to_string(r.operations) + " solves)";
+        } else {
+          line += "FAILED: " + modal::to_string(r.status) + ": " + r.message;
+        }
+        log::info(line);
+        std::lock_guard<std::mutex> g(lock);
+        outcome[h] = std::move(o);
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < workers; ++t) pool.emplace_back(work);
+    work();
+    for (auto& t : pool) t.join();
+  }
+
+  bool all_reused = true;
+  nlohmann::json per_h = nlohmann::json::array();
+  for (int h : canonical) {
+    HarmonicOutcome& o = outcome.at(h);
+    const auto& r = o.result.report;
+    all_reused = all_reused && o.reused;
+    nlohmann::json entry = {{"harmonic_index", h}, {"nodal_diameter", cyclic::nodal_diameter(h, nb)},
+                            {"reused", o.reused}, {"status", modal::to_string(r.status)},
+                            {"modes", o.result.basis.size()}};
+    if (!o.reused) {
+      entry.update({{"message", r.message}, {"method", r.method}, {"spectra_info", r.spectra_info},
+                    {"requested_eigenvalues", r.requested_eigenvalues},
+                    {"converged_eigenvalues", r.converged_eigenvalues}, {"restarts", r.iterations},
+                    {"solves", r.operations}, {"mass_products", r.mass_products},
+                    {"max_relative_residual", r.max_residual}, {"factor_nonzeros", r.factor_nonzeros},
+                    {"factor_seconds", r.factor_seconds}, {"lanczos_seconds", r.solve_seconds},
+                    {"seconds", o.seconds}});
+    }
+    per_h.push_back(entry);
+    if (!r.ok()) {
+      model.failures.push_back("harmonic index " + std::to_string(h) + ": " + modal::to_string(r.status) + ": " + r.message);
+      continue;
+    }
+    if (!r.message.empty()) ctx.report.warn("harmonic index " + std::to_string(h) + ": " + r.message);
+    if (!o.reused) {
+      try {
+        modal::save_basis(cache_dir / ("modes-" + modes_key(km_key, h, model.options) + ".bin"), o.result.basis);
+      } catch (const std::exception& e) {
+        ctx.report.warn(std::string("could not cache modes: ") + e.what());
+      }
+    }
+    if (o.result.stiffness.valid()) model.factors[h] = o.result.stiffness;
+  }
+  report["harmonic_indices"] = harmonic_indices;
+  report["solved"] = per_h;
+  for (int h : harmonic_indices) {
+    const int hc = std::min(h, (nb - h) % nb);
+    const HarmonicOutcome& o = outcome.at(hc);
+    if (!o.result.report.ok()) continue;
+    model.bases[h] = h == hc ? o.result.basis : o.result.basis.conjugate(h);
+  }
+  ctx.report.stage("modes", clock.seconds(), all_reused);
+  return model;
+}
+
+void write_modes_csv(Context& ctx, const ModalModel& model) {
+  std::ostringstream s;
+  s << "harmonic_index,nodal_diameter,mode,frequency_hz\n";
+  for (const auto& [h, b] : model.bases) {
+    const Eigen::VectorXd f = b.frequency_hz();
+    for (int r = 0; r < b.size(); ++r)
+      s << h << ',' << cyclic::nodal_diameter(h, model.mesh.sectors) << ',' << r + 1 << ',' << io::format_number(f(r)) << '\n';
+  }
+  io::write_file_atomic(ctx.out_dir / "modes.csv", s.str());
+}
+
+namespace {
+
+std::string base64(const std::vector<std::uint8_t>& data) {
+  static constexpr char kTable[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((data.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < data.size(); i += 3) {
+    const std::uint32_t v = (data[i] << 16) | (data[i + 1] << 8) | data[i + 2];
+    out += kTable[(v >> 18) & 63];
+    out += kTable[(v >> 12) & 63];
+    out += kTable[(v >> 6) & 63];
+    out += kTable[v & 63];
+  }
+  if (i < data.size()) {
+    std::uint32_t v = data[i] << 16;
+    if (i + 1 < data.size()) v |= data[i + 1] << 8;
+    out += kTable[(v >> 18) & 63];
+    out += kTable[(v >> 12) & 63];
+    out += i + 1 < data.size() ? kTable[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+// VTK XML inline binary: a UInt32 byte count, then the data, base64-encoded together.
+template <typename T>
+std::string vtk_binary(const std::vector<T>& values) {
+  const std::uint32_t bytes = static_cast<std::uint32_t>(values.size() * sizeof(T));
+  std::vector<std::uint8_t> buf(sizeof bytes + bytes);
+  std::memcpy(buf.data(), &bytes, sizeof bytes);
+  if (bytes) std::memcpy(buf.data() + sizeof bytes, values.data(), bytes);
+  return base64(buf);
+}
+
+}  // namespace
+
+void write_modes_vtu(Context& ctx, ModalModel& model) {
+  const mesh::Mesh& m = model.mesh;
+  const int npe = m.nodes_per_element();
+  // Field budget: at most 256 MiB of float32 point data.
+  const double per_field = 12.0 * m.n_nodes();
+  const int max_fields = std::max(1, static_cast<int>(256.0 * 1024 * 1024 / per_field));
+  int total = 0;
+  for (const auto& [h, b] : model.bases) total += b.size();
+  const int per_h_cap = total <= max_fields ? 1 << 30 : std::max(1, max_fields / static_cast<int>(model.bases.size()));
+  if (total > max_fields)
+    ctx.report.warn("modes.vtu holds the first " + std::to_string(per_h_cap) +
+                    " modes of each harmonic index (file size limit of 256 MiB)");
+
+  std::ostringstream s;
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+       "header_type=\"UInt32\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
+    << m.n_nodes() << "\" NumberOfCells=\"" << m.n_elements() << "\">\n<PointData>\n";
+  const cyclic::CyclicSector& sector = model.cyclic();
+  for (const auto& [h, b] : model.bases) {
+    const Eigen::VectorXd f = b.frequency_hz();
+    const int n = std::min(b.size(), per_h_cap);
+    const Eigen::MatrixXcd full = sector.expand(h, b.phi.leftCols(n));
+    for (int r = 0; r < n; ++r) {
+      Eigen::Index imax = 0;
+      full.col(r).cwiseAbs().maxCoeff(&imax);
+      const std::complex<double> turn = std::abs(full(imax, r)) > 0 ? std::conj(full(imax, r)) / std::abs(full(imax, r)) : 1.0;
+      const Eigen::VectorXd re = (full.col(r) * turn).real();
+      const double scale = re.cwiseAbs().maxCoeff() > 0 ? 1.0 / re.cwiseAbs().maxCoeff() : 1.0;
+      std::vector<float> v(re.size());
+      for (Eigen::Index i = 0; i < re.size(); ++i) v[i] = static_cast<float>(re(i) * scale);
+      s << "<DataArray type=\"Float32\" Name=\"h" << h << "_mode" << r + 1 << "_" << fixed(f(r), 1)
+        << "Hz\" NumberOfComponents=\"3\" format=\"binary\">\n" << vtk_binary(v) << "\n</DataArray>\n";
+    }
+  }
+  s << "</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">\n";
+  std::vector<double> xyz(m.nodes.data(), m.nodes.data() + m.nodes.size());  // row-major n x 3
+  s << vtk_binary(xyz) << "\n</DataArray>\n</Points>\n<Cells>\n";
+  // VTK quadratic tetra: edges (0,1) (1,2) (0,2) (0,3) (1,3) (2,3); gmsh: ... (2,3) (1,3).
+  static constexpr int kGmshToVtk10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
+  std::vector<std::int32_t> conn, offsets;
+  std::vector<std::uint8_t> types;
+  for (int e = 0; e < m.n_elements(); ++e) {
+    for (int a = 0; a < npe; ++a) conn.push_back(m.tets(e, npe == 10 ? kGmshToVtk10[a] : a));
+    offsets.push_back(static_cast<std::int32_t>(conn.size()));
+    types.push_back(npe == 10 ? 24 : 10);
+  }
+  s << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"binary\">\n" << vtk_binary(conn) << "\n</DataArray>\n"
+    << "<DataArray type=\"Int32\" Name=\"offsets\" format=\"binary\">\n" << vtk_binary(offsets) << "\n</DataArray>\n"
+    << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n" << vtk_binary(types) << "\n</DataArray>\n"
+    << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  io::write_file_atomic(ctx.out_dir / "modes.vtu", s.str());
+}
+
+void draw_plots(Context& ctx) {
+  const fs::path script = fs::path(SHROUDSIM_SOURCE_DIR) / "tools" / "plot.py";
+  const char* python = "/usr/bin/python3";
+  if (!fs::exists(python) || !fs::exists(script) ||
+      std::system((std::string(python) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0) {
+    log::info("plots skipped (needs /usr/bin/python3 with matplotlib and " + script.string() + ")");
+    ctx.report.section("plots")["drawn"] = false;
+    return;
+  }
+  const std::string cmd = std::string(python) + " '" + script.string() + "' '" + ctx.out_dir.string() + "'";
+  const int rc = std::system(cmd.c_str());
+  ctx.report.section("plots")["drawn"] = rc == 0;
+  if (rc != 0) ctx.report.warn("plotting failed (" + cmd + ")");
+}
+
+int cmd_modes(Context& ctx) {
+  const io::Case& c = ctx.config;
+  if (c.structure.type != "sector")
+    throw InputError(location(c, "structure.type") + ": structure.type = \"" + c.structure.type +
+                     "\": `modes` needs an FE sector (structure.type = \"sector\")");
+  ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c));
+  write_modes_csv(ctx, model);
+  if (!model.bases.empty()) write_modes_vtu(ctx, model);
+  if (!model.failures.empty()) {
+    std::string msg = "modal analysis failed for";
+    for (const auto& f : model.failures) msg += "\n  " + f;
+    throw NumericalError(msg + "\n(modes.csv holds the harmonic indices that converged)");
+  }
+  draw_plots(ctx);
+  return 0;
 }
 
 }  // namespace shroudsim::app

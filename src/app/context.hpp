@@ -32,6 +32,8 @@ struct Context {
   io::Case config;                  ///< the case as run (after --set)
   std::filesystem::path out_dir;    ///< result folder (created on demand)
   int threads = 0;                  ///< 0: all cores
+  std::vector<std::string> overrides;  ///< the command line's --set KEY=VALUE, in order
+  bool plots = true;                ///< draw plots after a command (off for study points)
   RunReport report;
 };
 

@@ -1,6 +1,7 @@
 #include "io/case.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -557,7 +558,13 @@ void read_all(Reader& r, Case& c) {
       for (const auto& e : *a) {
         std::ostringstream s;
         if (auto str = e.as_string()) s << '"' << str->get() << '"';
-        else e.visit([&](auto&& x) {
+        else if (auto fl = e.as_floating_point()) {
+          char buf[32];  // shortest text that reads back to the same double
+          const auto res = std::to_chars(buf, buf + sizeof buf, fl->get());
+          std::string t(buf, res.ptr);
+          if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
+          s << t;
+        } else e.visit([&](auto&& x) {
           if constexpr (toml::is_array<decltype(x)>) s << toml::toml_formatter{x, toml::format_flags::none};
           else if constexpr (toml::is_table<decltype(x)>) s << "{}";
           else s << x;

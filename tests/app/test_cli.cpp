@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <sstream>
 
 #include "cli_runner.hpp"
 
@@ -126,6 +127,88 @@ TEST(Cli, GivenMeshIsCheckedAndItsProblemsNamed) {
   EXPECT_EQ(nohub.status, kBadInput);
   EXPECT_NE(nohub.err.find("nohub.toml:3:8: structure.mesh"), std::string::npos) << nohub.err;
   EXPECT_NE(nohub.err.find("missing 2D physical group(s): hub"), std::string::npos) << nohub.err;
+}
+
+}  // namespace
+}  // namespace shroudsim::testing
+
+namespace shroudsim::testing {
+namespace {
+
+/// 1-DOF oscillator with a Jenkins element (the lumped forced-response case).
+const char* kLumpedCase = R"(name = "jenkins"
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[1.0]]
+stiffness = [[3947.8417604357433]]
+damping = [[1.2566370614359172]]
+[excitation]
+force = 0.5
+[contact]
+model = "1d"
+tangential_stiffness = 3947.8417604357433
+normal_preload = 1.0
+[[contact.elements]]
+x_dof = 0
+[hbm]
+harmonics = 3
+time_samples = 64
+[continuation]
+frequency_start_hz = 5.0
+frequency_end_hz = 25.0
+initial_step = 0.2
+[study]
+vary = { "contact.normal_preload" = [0.5, 2.0], "contact.friction_coefficient" = [0.3] }
+)";
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream s(text);
+  for (std::string line; std::getline(s, line);) out.push_back(line);
+  return out;
+}
+
+TEST(Cli, FrfWritesTheContractColumnsAndNoNaN) {
+  const Scratch s("frf");
+  s.write("case.toml", kLumpedCase);
+  const CliResult r = s.run("frf case.toml --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "frf.csv"));
+  ASSERT_GT(lines.size(), 20u);
+  EXPECT_EQ(lines[0], "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations,h0_m,h1_m,h2_m,h3_m");
+  for (const auto& l : lines) {
+    EXPECT_EQ(l.find("nan"), std::string::npos) << l;
+    EXPECT_EQ(l.find("inf"), std::string::npos) << l;
+  }
+  const std::string run = slurp(s.dir() / "results" / "jenkins" / "run.json");
+  EXPECT_NE(run.find("\"max_energy_balance_error\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "loops.csv"));
+}
+
+TEST(Cli, ContinuationThatCannotFinishExitsThreeWithWhatItHas) {
+  const Scratch s("frf3");
+  s.write("case.toml", kLumpedCase);
+  const CliResult r = s.run("frf case.toml --quiet --set continuation.max_points=5");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("max_points"), std::string::npos) << r.err;
+  const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "frf.csv"));
+  EXPECT_EQ(lines.size(), 6u);  // header + the 5 points computed
+  EXPECT_NE(slurp(s.dir() / "results" / "jenkins" / "run.json").find("\"status\": \"numerics_failed\""), std::string::npos);
+}
+
+TEST(Cli, StudyRunsEveryPointInItsOwnFolder) {
+  const Scratch s("study");
+  s.write("case.toml", kLumpedCase);
+  const CliResult r = s.run("study case.toml --quiet --threads 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "study.csv"));
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].rfind("contact.friction_coefficient,contact.normal_preload,status,peak_amplitude_m", 0), 0u) << lines[0];
+  EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "friction_coefficient=0.3__normal_preload=0.5" / "frf.csv"));
+  // A higher preload sticks more: the 2 N point's peak is lower than the 0.5 N one.
+  auto peak = [&](const std::string& line) { return std::stod(line.substr(line.find(",ok,") + 4)); };
+  EXPECT_LT(peak(lines[2]), peak(lines[1]));
 }
 
 }  // namespace

@@ -1,0 +1,67 @@
+#pragma once
+// The linear modal stage shared by `modes`, `campbell` and the forced response: the sector
+// mesh, its K and M, the cyclic reduction and the modes of the harmonic indices a command
+// needs. K, M and the modes of each harmonic index are cached in <case directory>/.cache/
+// under fingerprints of what they depend on (mesh, material; plus h, number of modes and
+// solver settings for the modes), so a second run with other contact or excitation
+// settings reuses them; run.json ("modal" section, stage list) says what was reused.
+//
+// Harmonic indices h and Nb - h share one solve: the modes of Nb - h are the conjugates of
+// those of h (K_{Nb-h} = conj(K_h)).
+//
+// Usage (forced response, harmonic index h):
+//   ModalModel model = run_modal_stage(ctx, {0, 1, 2});
+//   const modal::ModalBasis& b = model.bases.at(h);               // omega [rad/s], phi
+//   const cyclic::CyclicSector& cs = model.cyclic();              // T_h: cs.expansion(h)
+//   modal::StiffnessFactor Kh = model.stiffness_factor(h);        // K_h^{-1} (kept, lazy)
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/context.hpp"
+#include "cyclic/cyclic_sector.hpp"
+#include "fe/tet_element.hpp"
+#include "linalg/sparse.hpp"
+#include "modal/eigensolver.hpp"
+
+namespace shroudsim::app {
+
+struct ModalModel {
+  mesh::Mesh mesh;
+  fe::Material material;
+  modal::ModalOptions options;
+  linalg::SparsePair<double> km;              ///< sector K [N/m], M [kg] on all 3 * n_nodes DOFs
+  std::map<int, modal::ModalBasis> bases;     ///< per harmonic index (reduced DOFs of that h)
+  std::map<int, modal::StiffnessFactor> factors;  ///< K_h factors kept from the solves (h with shift 0)
+  std::vector<std::string> failures;          ///< harmonic indices whose modes failed (message each)
+
+  /// The cyclic reduction of the sector (built on first use).
+  const cyclic::CyclicSector& cyclic();
+  /// The factorization of K_h: kept from the modal solve if there was one, else computed.
+  modal::StiffnessFactor stiffness_factor(int harmonic_index);
+
+ private:
+  std::unique_ptr<cyclic::CyclicSector> cyclic_;
+};
+
+/// [modal] harmonic_indices ("all": 0..Nb-1), sorted, unique. Throws InputError for an
+/// index outside 0..Nb-1.
+std::vector<int> modal_harmonic_indices(const io::Case& c);
+
+/// Mesh (obtain_mesh), K and M, and the modes of `harmonic_indices` (cached where possible).
+/// A harmonic index whose solve fails is listed in ModalModel::failures (the caller writes
+/// what converged and throws NumericalError).
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices);
+
+/// modes.csv: harmonic_index,nodal_diameter,mode,frequency_hz (mode numbered from 1).
+void write_modes_csv(Context& ctx, const ModalModel& model);
+/// modes.vtu: the sector mesh with one point-data field per mode ("h<h>_mode<r>_<f>Hz"),
+/// the real part of the mode shape on every node (cyclic_high included) after turning its
+/// phase so that the largest component is real.
+void write_modes_vtu(Context& ctx, ModalModel& model);
+/// Runs tools/plot.py on the result folder when /usr/bin/python3 has matplotlib; otherwise
+/// says that plots are skipped. A plotting failure is a warning, not an error.
+void draw_plots(Context& ctx);
+
+}  // namespace shroudsim::app

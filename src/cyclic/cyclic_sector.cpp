@@ -1,0 +1,152 @@
+#include "cyclic/cyclic_sector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "fe/assembly.hpp"
+
+namespace shroudsim::cyclic {
+
+using linalg::Complex;
+using linalg::SparseMatrixC;
+using linalg::SparseMatrixD;
+
+Eigen::Matrix3d rotation_z(double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  Eigen::Matrix3d R;
+  R << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
+  return R;
+}
+
+int nodal_diameter(int h, int sectors) {
+  const int m = ((h % sectors) + sectors) % sectors;
+  return std::min(m, sectors - m);
+}
+
+CyclicSector::CyclicSector(const mesh::Mesh& mesh, const linalg::SparsePair<double>& km)
+    : sectors_(mesh.sectors), n_full_(mesh.n_dofs()) {
+  SHROUDSIM_CHECK(sectors_ >= 1, "CyclicSector: mesh.sectors must be >= 1");
+  SHROUDSIM_CHECK(km.K.rows() == n_full_ && km.M.rows() == n_full_,
+                  "CyclicSector: matrices do not match the mesh");
+  const int n_nodes = mesh.n_nodes();
+  const double alpha = 2.0 * std::numbers::pi / sectors_;
+  const Eigen::Matrix3d R = rotation_z(alpha);
+
+  // Pairing, with the geometric check x_q = R x_p.
+  const double size = (mesh.nodes.colwise().maxCoeff() - mesh.nodes.colwise().minCoeff()).norm();
+  constexpr double kMatchTol = 1e-6;  // relative to the mesh size; gmsh writes ~16 digits
+  std::vector<int> high_partner(n_nodes, -1), low_partner(n_nodes, -1);
+  for (const auto& [p, q] : mesh.cyclic_pairs) {
+    if (p < 0 || q < 0 || p >= n_nodes || q >= n_nodes || p == q || high_partner[p] >= 0 ||
+        low_partner[q] >= 0 || low_partner[p] >= 0 || high_partner[q] >= 0)
+      throw InputError("mesh: cyclic pair (" + std::to_string(p) + ", " + std::to_string(q) +
+                       ") is invalid or uses a node twice");
+    const Eigen::Vector3d xp = mesh.nodes.row(p).transpose(), xq = mesh.nodes.row(q).transpose();
+    if ((xq - R * xp).norm() > kMatchTol * size)
+      throw InputError("mesh: cyclic_high node " + std::to_string(q) +
+                       " is not cyclic_low node " + std::to_string(p) + " rotated by 360/" +
+                       std::to_string(sectors_) + " degrees about z");
+    high_partner[p] = q;
+    low_partner[q] = p;
+  }
+  // Clamped nodes: hub, and the cyclic partners of hub nodes.
+  std::vector<char> clamped(n_nodes, 0);
+  if (auto it = mesh.node_sets.find(mesh::kHub); it != mesh.node_sets.end())
+    for (int v : it->second) clamped[v] = 1;
+  for (int v = 0; v < n_nodes; ++v) {
+    if (!clamped[v]) continue;
+    if (high_partner[v] >= 0) clamped[high_partner[v]] = 1;
+    if (low_partner[v] >= 0) clamped[low_partner[v]] = 1;
+  }
+  std::vector<int> reduced_of(n_full_, -1);
+  for (int v = 0; v < n_nodes; ++v) {
+    for (int c = 0; c < 3; ++c) {
+      if (clamped[v]) {
+        clamped_dofs_.push_back(3 * v + c);
+      } else if (low_partner[v] < 0) {
+        reduced_of[3 * v + c] = static_cast<int>(reduced_to_full_.size());
+        reduced_to_full_.push_back(3 * v + c);
+      }
+    }
+  }
+  const auto n_r = static_cast<Eigen::Index>(reduced_to_full_.size());
+  std::vector<Eigen::Triplet<double>> tp, tg;
+  for (Eigen::Index j = 0; j < n_r; ++j) tp.emplace_back(reduced_to_full_[j], static_cast<int>(j), 1.0);
+  for (int q = 0; q < n_nodes; ++q) {
+    const int p = low_partner[q];
+    if (p < 0 || clamped[q]) continue;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (R(i, j) != 0.0) tg.emplace_back(3 * q + i, reduced_of[3 * p + j], R(i, j));
+  }
+  P_.resize(n_full_, n_r);
+  P_.setFromTriplets(tp.begin(), tp.end());
+  G_.resize(n_full_, n_r);
+  G_.setFromTriplets(tg.begin(), tg.end());
+
+  auto split = [&](const SparseMatrixD& K, SparseMatrixD& A, SparseMatrixD& B) {
+    const SparseMatrixD KG = K * G_;
+    const SparseMatrixD GtKG = SparseMatrixD(G_.transpose()) * KG;
+    A = fe::restrict(K, reduced_to_full_) + GtKG;
+    B = SparseMatrixD(P_.transpose()) * KG;
+  };
+  split(km.K, KA_, KB_);
+  split(km.M, MA_, MB_);
+}
+
+void CyclicSector::check_h(int h) const {
+  SHROUDSIM_CHECK(h >= 0 && h < sectors_, "CyclicSector: harmonic index out of range 0..Nb-1");
+}
+
+bool CyclicSector::is_real(int h) const {
+  check_h(h);
+  return h == 0 || 2 * h == sectors_;
+}
+
+Complex CyclicSector::phase(int h) const {
+  check_h(h);
+  if (h == 0) return 1.0;
+  if (2 * h == sectors_) return -1.0;
+  return std::polar(1.0, 2.0 * std::numbers::pi * h / sectors_);
+}
+
+namespace {
+SparseMatrixC combine(const SparseMatrixD& A, const SparseMatrixD& B, Complex e) {
+  const SparseMatrixD Bt = B.transpose();
+  SparseMatrixC out = A.cast<Complex>() + B.cast<Complex>() * e + Bt.cast<Complex>() * std::conj(e);
+  out.makeCompressed();
+  return out;
+}
+}  // namespace
+
+linalg::SparsePair<Complex> CyclicSector::reduce(int h) const {
+  const Complex e = phase(h);
+  return {combine(KA_, KB_, e), combine(MA_, MB_, e)};
+}
+
+linalg::SparsePair<double> CyclicSector::reduce_real(int h) const {
+  SHROUDSIM_CHECK(is_real(h), "CyclicSector::reduce_real: h must be 0 or Nb/2");
+  const double s = phase(h).real();
+  auto combine_real = [s](const SparseMatrixD& A, const SparseMatrixD& B) {
+    const SparseMatrixD Bt = B.transpose();
+    SparseMatrixD out = A + s * (B + Bt);
+    out.makeCompressed();
+    return out;
+  };
+  return {combine_real(KA_, KB_), combine_real(MA_, MB_)};
+}
+
+SparseMatrixC CyclicSector::expansion(int h) const {
+  SparseMatrixC T = P_.cast<Complex>() + G_.cast<Complex>() * phase(h);
+  T.makeCompressed();
+  return T;
+}
+
+Eigen::MatrixXcd CyclicSector::expand(int h, const Eigen::MatrixXcd& u_reduced) const {
+  SHROUDSIM_CHECK(u_reduced.rows() == n_reduced(), "CyclicSector::expand: wrong number of rows");
+  return expansion(h) * u_reduced;
+}
+
+}  // namespace shroudsim::cyclic

@@ -1,0 +1,72 @@
+#pragma once
+// Cyclic-symmetry reduction of a sector (../shared/PHYSICS.md section 1).
+//
+// Nb sectors, alpha = 2 pi / Nb, R = rotation by +alpha about z. For harmonic index h
+// (0 <= h < Nb) every matched pair (low p, high q = R p) obeys u_q = exp(i h alpha) R u_p.
+// The reduced DOFs u_r are the sector DOFs that are neither cyclic_high nor clamped; the
+// clamped DOFs are those of the `hub` nodes and of their cyclic partners. With
+//   u = T_h u_r,   T_h = P + exp(i h alpha) G
+// (P copies kept DOFs, G maps low DOFs onto their high partners through R), the reduced
+// matrices are
+//   K_h = T_h^H K T_h = A + exp(i h alpha) B + exp(-i h alpha) B^T,
+//   A = P^T K P + G^T K G,   B = P^T K G      (the same for M),
+// Hermitian, and real for h = 0 and h = Nb/2. A and B are formed once, so every harmonic
+// index costs one sparse sum. K_{Nb-h} = conj(K_h), T_{Nb-h} = conj(T_h).
+//
+// Usage:
+//   fe::Assembler assembler(mesh);
+//   cyclic::CyclicSector sector(mesh, assembler.assemble(material));
+//   linalg::SparsePair<linalg::Complex> kmh = sector.reduce(h);
+//   Eigen::MatrixXcd u_full = sector.expand(h, phi);      // 3 * n_nodes rows, all nodes
+#include <vector>
+
+#include "linalg/sparse.hpp"
+#include "mesh/mesh.hpp"
+
+namespace shroudsim::cyclic {
+
+/// Rotation by `angle` [rad] about the global z axis.
+Eigen::Matrix3d rotation_z(double angle);
+
+/// Nodal diameter of harmonic index h: min(h mod Nb, Nb - h mod Nb).
+int nodal_diameter(int h, int sectors);
+
+class CyclicSector {
+ public:
+  /// km: the sector's K and M on all 3 * n_nodes DOFs (fe::Assembler). Throws InputError if
+  /// the cyclic pairs do not match under R (relative tolerance 1e-6 of the mesh size) or a
+  /// node is paired twice.
+  CyclicSector(const mesh::Mesh& mesh, const linalg::SparsePair<double>& km);
+
+  int sectors() const { return sectors_; }
+  Eigen::Index n_full() const { return n_full_; }
+  Eigen::Index n_reduced() const { return static_cast<Eigen::Index>(reduced_to_full_.size()); }
+  /// Full sector DOF (3 * node + component) of each reduced DOF, ascending.
+  const std::vector<int>& reduced_to_full() const { return reduced_to_full_; }
+  /// Full DOFs that are clamped (hub nodes and their cyclic partners), ascending.
+  const std::vector<int>& clamped_dofs() const { return clamped_dofs_; }
+
+  /// h = 0, or h = Nb/2 for even Nb: K_h, M_h and T_h are real.
+  bool is_real(int h) const;
+  /// exp(i h alpha).
+  linalg::Complex phase(int h) const;
+
+  /// K_h, M_h (Hermitian, n_reduced x n_reduced, full storage). 0 <= h < Nb.
+  linalg::SparsePair<linalg::Complex> reduce(int h) const;
+  /// Real K_h, M_h for is_real(h).
+  linalg::SparsePair<double> reduce_real(int h) const;
+  /// T_h: n_full x n_reduced (complex; real-valued for is_real(h)).
+  linalg::SparseMatrixC expansion(int h) const;
+  /// T_h u: reduced DOF vectors (columns) to all sector DOFs, cyclic_high nodes included.
+  Eigen::MatrixXcd expand(int h, const Eigen::MatrixXcd& u_reduced) const;
+
+ private:
+  void check_h(int h) const;
+  int sectors_ = 1;
+  Eigen::Index n_full_ = 0;
+  std::vector<int> reduced_to_full_, clamped_dofs_;
+  linalg::SparseMatrixD P_, G_;        // n_full x n_reduced
+  linalg::SparseMatrixD KA_, KB_, MA_, MB_;
+};
+
+}  // namespace shroudsim::cyclic

@@ -1,0 +1,1 @@
+#include "frf/linear_part.hpp"

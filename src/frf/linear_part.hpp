@@ -1,0 +1,46 @@
+#pragma once
+// The linear structure as the harmonic balance sees it (PHYSICS.md sections 2 and 3).
+//
+// For temporal harmonic n at circular frequency W = n w [rad/s], with the relative
+// displacement operator B_n of the contact pairs (c = 3 * pairs rows: x, y, z of each pair
+// in its local frame), the excitation f_ext,n and the response DOFs D:
+//   G_n       = B_n R(W) B_n^H          (c x c)   [m/N]
+//   w_lin,n   = B_n R(W) f_ext,n        (c)       [m]
+//   H_n       = D R(W) B_n^H            (d x c)   [m/N]
+//   u_lin,n   = D R(W) f_ext,n          (d)       [m]
+// so that with contact forces F_n:  W_n = w_lin,n - G_n F_n  and  U_n = u_lin,n - H_n F_n.
+// n = 0 is the static part (W = 0, real). Complex amplitudes follow u = Re(U e^{i n w t}).
+//
+// The energy the linear part dissipates per fundamental period for given complex forces on
+// the contact pairs is needed for the energy balance; each model supplies it.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace shroudsim::frf {
+
+struct HarmonicReceptance {
+  Eigen::MatrixXcd G;       ///< c x c
+  Eigen::VectorXcd w_lin;   ///< c
+  Eigen::MatrixXcd H;       ///< d x c
+  Eigen::VectorXcd u_lin;   ///< d
+};
+
+class LinearPart {
+ public:
+  virtual ~LinearPart() = default;
+  /// c: 3 * number of contact pairs.
+  virtual int n_contact() const = 0;
+  /// d: response DOFs (3 for a sector node, 1 for a lumped DOF).
+  virtual int n_response() const = 0;
+  /// The receptances of temporal harmonic n (>= 0) at fundamental circular frequency w.
+  virtual void harmonic(int n, double w, HarmonicReceptance& out) const = 0;
+  /// Work of the excitation per fundamental period [J] and viscous dissipation per period
+  /// [J], given the complex contact forces F_n (n = 0..H, each of size c) at frequency w.
+  virtual void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
+                      double& viscous_dissipation) const = 0;
+  /// Human-readable description (for run.json).
+  virtual std::string describe() const = 0;
+};
+
+}  // namespace shroudsim::frf

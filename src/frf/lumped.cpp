@@ -1,0 +1,92 @@
+#include "frf/lumped.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+namespace shroudsim::frf {
+
+LumpedLinearPart::LumpedLinearPart(Eigen::MatrixXd mass, Eigen::MatrixXd stiffness, Eigen::MatrixXd damping,
+                                   std::vector<LumpedContact> contacts, int excited_dof, double force,
+                                   int response_dof)
+    : m_(std::move(mass)),
+      k_(std::move(stiffness)),
+      c_(std::move(damping)),
+      contacts_(std::move(contacts)),
+      excited_dof_(excited_dof),
+      response_dof_(response_dof),
+      force_(force) {
+  const Eigen::Index n = m_.rows();
+  if (n == 0 || m_.cols() != n || k_.rows() != n || k_.cols() != n)
+    throw std::invalid_argument("lumped model: mass and stiffness must be square and of one size");
+  if (c_.size() == 0) c_ = Eigen::MatrixXd::Zero(n, n);
+  if (c_.rows() != n || c_.cols() != n) throw std::invalid_argument("lumped model: damping must match the mass size");
+  if (excited_dof < 0 || excited_dof >= n || response_dof < 0 || response_dof >= n)
+    throw std::invalid_argument("lumped model: excitation or response DOF out of range");
+  b_ = Eigen::MatrixXd::Zero(n_contact(), n);
+  for (std::size_t e = 0; e < contacts_.size(); ++e)
+    for (int d = 0; d < 3; ++d) {
+      const int a = contacts_[e].dof[d], o = contacts_[e].other[d];
+      if (a >= n || o >= n) throw std::invalid_argument("lumped model: contact DOF out of range");
+      if (a < 0) continue;
+      b_(3 * static_cast<Eigen::Index>(e) + d, a) += 1.0;
+      if (o >= 0) b_(3 * static_cast<Eigen::Index>(e) + d, o) -= 1.0;
+    }
+  // Local tangential axes turned by the frame angle: t1 = cos x + sin y, t2 = -sin x + cos y.
+  for (std::size_t e = 0; e < contacts_.size(); ++e) {
+    const double c = std::cos(contacts_[e].frame_angle), s = std::sin(contacts_[e].frame_angle);
+    const Eigen::Index r = 3 * static_cast<Eigen::Index>(e);
+    const Eigen::RowVectorXd x = b_.row(r), y = b_.row(r + 1);
+    b_.row(r) = c * x + s * y;
+    b_.row(r + 1) = -s * x + c * y;
+  }
+}
+
+void LumpedLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const {
+  const double big_w = n * w;
+  const Eigen::MatrixXcd dyn = k_.cast<std::complex<double>>() - big_w * big_w * m_.cast<std::complex<double>>() +
+                               std::complex<double>(0.0, big_w) * c_.cast<std::complex<double>>();
+  const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(dyn);
+  // R B^H: one solve per contact direction; R f: one solve.
+  const Eigen::MatrixXcd rbh = lu.solve(b_.transpose().cast<std::complex<double>>());
+  Eigen::VectorXcd f = Eigen::VectorXcd::Zero(m_.rows());
+  if (n == 1) f[excited_dof_] = force_;
+  const Eigen::VectorXcd rf = lu.solve(f);
+  out.G = b_.cast<std::complex<double>>() * rbh;
+  out.w_lin = b_.cast<std::complex<double>>() * rf;
+  out.H = rbh.row(response_dof_);
+  out.u_lin = rf.segment(response_dof_, 1);
+}
+
+Eigen::VectorXcd LumpedLinearPart::displacement(int n, double w, const Eigen::VectorXcd& contact_force) const {
+  const double big_w = n * w;
+  const Eigen::MatrixXcd dyn = k_.cast<std::complex<double>>() - big_w * big_w * m_.cast<std::complex<double>>() +
+                               std::complex<double>(0.0, big_w) * c_.cast<std::complex<double>>();
+  Eigen::VectorXcd f = -b_.transpose().cast<std::complex<double>>() * contact_force;
+  if (n == 1) f[excited_dof_] += force_;
+  return Eigen::PartialPivLU<Eigen::MatrixXcd>(dyn).solve(f);
+}
+
+void LumpedLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
+                              double& viscous_dissipation) const {
+  constexpr double kPi = std::numbers::pi;
+  excitation_work = 0.0;
+  viscous_dissipation = 0.0;
+  for (std::size_t n = 1; n < forces.size(); ++n) {
+    const Eigen::VectorXcd u = displacement(static_cast<int>(n), w, forces[n]);
+    // Per fundamental period: harmonic n makes n cycles; int u'^T C u' dt = pi n^2 w U^H C U.
+    viscous_dissipation += kPi * n * n * w * (u.adjoint() * c_.cast<std::complex<double>>() * u)(0, 0).real();
+    // Work of f = Re(F e^{i w t}) on u: pi Im(F conj(U)).
+    if (n == 1) excitation_work += kPi * (force_ * std::conj(u[excited_dof_])).imag();
+  }
+}
+
+std::string LumpedLinearPart::describe() const {
+  std::ostringstream s;
+  s << "lumped model, " << m_.rows() << " DOFs, " << contacts_.size() << " contact elements";
+  return s.str();
+}
+
+}  // namespace shroudsim::frf

@@ -1,0 +1,145 @@
+#include "frf/sector.hpp"
+
+#include <Eigen/SparseCore>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace shroudsim::frf {
+namespace {
+
+using Complex = std::complex<double>;
+
+/// C_h = [B; D; E] (k x n_full) for harmonic index h.
+Eigen::SparseMatrix<Complex> selection(const std::vector<SectorContactPair>& pairs, const SectorForcing& f,
+                                       const cyclic::CyclicSector& sector, int h, Eigen::Index n_full) {
+  const double alpha = 2.0 * std::numbers::pi / sector.sectors();
+  const Eigen::Matrix3d rot = cyclic::rotation_z(alpha);
+  const Complex phase = std::exp(Complex(0.0, h * alpha));
+  std::vector<Eigen::Triplet<Complex>> t;
+  const int c = 3 * static_cast<int>(pairs.size());
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const Eigen::Matrix3d& l = pairs[i].frame;
+    const Eigen::Matrix3d lr = l * rot;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        const int row = 3 * static_cast<int>(i) + a;
+        t.emplace_back(row, 3 * pairs[i].high_node + b, l(a, b));
+        t.emplace_back(row, 3 * pairs[i].low_node + b, -phase * lr(a, b));
+      }
+  }
+  for (int a = 0; a < 3; ++a) t.emplace_back(c + a, 3 * f.response_node + a, 1.0);
+  for (int a = 0; a < 3; ++a) t.emplace_back(c + 3, 3 * f.excitation_node + a, f.force[a]);
+  Eigen::SparseMatrix<Complex> m(c + 4, n_full);
+  m.setFromTriplets(t.begin(), t.end());
+  return m;
+}
+
+}  // namespace
+
+int SectorLinearPart::harmonic_index(int n) const {
+  return ((n * forcing_.engine_order) % sectors_ + sectors_) % sectors_;
+}
+
+SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
+                                   const std::function<modal::StiffnessFactor(int)>& factor,
+                                   std::vector<SectorContactPair> pairs, SectorForcing forcing, int n_harmonics)
+    : pairs_(std::move(pairs)), forcing_(forcing), sectors_(sector.sectors()), n_harmonics_(n_harmonics) {
+  SHROUDSIM_CHECK(forcing_.excitation_node >= 0 && forcing_.response_node >= 0, "excitation and response nodes set");
+  std::set<int> needed;
+  for (int n = 1; n <= n_harmonics_; ++n) needed.insert(harmonic_index(n));
+  // Static flexibility of the static harmonic (h = 0) and of each dynamic index's residual.
+  auto static_flexibility = [&](int h, const Eigen::MatrixXcd& ct) {
+    const modal::StiffnessFactor k = factor(h);
+    const Eigen::MatrixXcd y = k.solve(ct.adjoint());
+    return Eigen::MatrixXcd(ct * y);
+  };
+  auto projected = [&](int h) {
+    const Eigen::SparseMatrix<Complex> c = selection(pairs_, forcing_, sector, h, sector.n_full());
+    const Eigen::SparseMatrix<Complex> t = sector.expansion(h);
+    return Eigen::MatrixXcd(Eigen::MatrixXcd(c * t));
+  };
+  {
+    const Eigen::MatrixXcd ct = projected(0);
+    static_.flex = static_flexibility(0, ct);
+  }
+  for (int h : needed) {
+    auto it = bases.find(h);
+    SHROUDSIM_CHECK(it != bases.end(), "modes of harmonic index " + std::to_string(h) + " given");
+    const modal::ModalBasis& b = it->second;
+    IndexData d;
+    d.omega = b.omega;
+    const Eigen::MatrixXcd ct = projected(h);
+    d.psi = ct * b.phi;
+    if (forcing_.residual_flexibility) {
+      d.flex = static_flexibility(h, ct);
+      for (Eigen::Index r = 0; r < d.omega.size(); ++r)
+        d.flex -= d.psi.col(r) * d.psi.col(r).adjoint() / (d.omega[r] * d.omega[r]);
+    } else {
+      d.flex = Eigen::MatrixXcd::Zero(ct.rows(), ct.rows());
+    }
+    dynamic_[h] = std::move(d);
+  }
+}
+
+Eigen::MatrixXcd SectorLinearPart::receptance(int n, double w) const {
+  if (n == 0) return static_.flex;
+  const IndexData& d = dynamic_.at(harmonic_index(n));
+  const double big_w = n * w, z = forcing_.damping_ratio;
+  Eigen::VectorXcd inv(d.omega.size());
+  for (Eigen::Index r = 0; r < d.omega.size(); ++r)
+    inv[r] = 1.0 / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+  return d.psi * inv.asDiagonal() * d.psi.adjoint() + d.flex;
+}
+
+void SectorLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const {
+  const Eigen::MatrixXcd q = receptance(n, w);
+  const int c = n_contact();
+  out.G = q.topLeftCorner(c, c);
+  out.H = q.block(c, 0, 3, c);
+  if (n == 1) {
+    out.w_lin = q.block(0, c + 3, c, 1);
+    out.u_lin = q.block(c, c + 3, 3, 1);
+  } else {
+    out.w_lin = Eigen::VectorXcd::Zero(c);
+    out.u_lin = Eigen::VectorXcd::Zero(3);
+  }
+}
+
+void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
+                              double& viscous_dissipation) const {
+  constexpr double kPi = std::numbers::pi;
+  excitation_work = 0.0;
+  viscous_dissipation = 0.0;
+  const int c = n_contact();
+  for (std::size_t n = 1; n < forces.size(); ++n) {
+    // Generalised load g = [-F_n; 0; delta_n1]: f_total = C^H g.
+    Eigen::VectorXcd g = Eigen::VectorXcd::Zero(c + 4);
+    g.head(c) = -forces[n];
+    if (n == 1) g[c + 3] = 1.0;
+    const IndexData& d = dynamic_.at(harmonic_index(static_cast<int>(n)));
+    const double big_w = static_cast<double>(n) * w, z = forcing_.damping_ratio;
+    const Eigen::VectorXcd p = d.psi.adjoint() * g;  // modal loads
+    for (Eigen::Index r = 0; r < d.omega.size(); ++r) {
+      const Complex q = p[r] / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+      // Modal viscous force 2 z w_r q'; per fundamental period pi n^2 w c_r |q|^2.
+      viscous_dissipation += kPi * static_cast<double>(n * n) * w * 2.0 * z * d.omega[r] * std::norm(q);
+    }
+    if (n == 1) {
+      const Complex u_e = (receptance(1, w) * g)[c + 3];  // E U_1: displacement along the force
+      excitation_work += kPi * (-u_e.imag());            // pi Im(1 * conj(U_e))
+    }
+  }
+}
+
+std::string SectorLinearPart::describe() const {
+  std::ostringstream s;
+  s << "FE sector (Nb = " << sectors_ << ", engine order " << forcing_.engine_order << ", harmonic indices";
+  for (const auto& [h, d] : dynamic_) s << " " << h << " (" << d.omega.size() << " modes)";
+  s << (forcing_.residual_flexibility ? ", residual flexibility" : ", no residual flexibility") << ")";
+  return s.str();
+}
+
+}  // namespace shroudsim::frf

@@ -1,0 +1,77 @@
+#pragma once
+// The FE sector as the harmonic balance sees it (PHYSICS.md sections 2 and 3): modal
+// receptances of harmonic index h_n = n m mod Nb between the shroud contact pairs, the
+// excitation and the response node, with optional residual flexibility, and the exact
+// static flexibility for n = 0.
+//
+// For each harmonic n, the rows C_n = [B_n; D; E] (c contact rows, 3 response rows, one
+// excitation row E = f_ext^T at the excitation node) are mapped to the reduced DOFs of
+// h_n by T_h, and Q_n(W) = C_n R_h(W) C_n^H gives G_n, w_lin,n, H_n and u_lin,n as blocks:
+//   R_h(W) = sum_r phi_r phi_r^H / (w_r^2 - W^2 + 2 i z w_r W)
+//            + [residual] T_h K_h^-1 T_h^H - sum_r phi_r phi_r^H / w_r^2        (n >= 1)
+//   R_0    = T_0 K_0^-1 T_0^T                                                 (n = 0)
+// Contact pair i joins high node q (shroud_high of sector k) and the low node p' of
+// sector k+1, p' = R p with p the matched shroud_low node of the reference sector:
+//   W_n,i = L_i (U_q,n - exp(i h_n alpha) R U_p,n),   L_i = [t1; t2; n] (rows).
+#include <Eigen/Core>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "cyclic/cyclic_sector.hpp"
+#include "frf/linear_part.hpp"
+#include "modal/eigensolver.hpp"
+
+namespace shroudsim::frf {
+
+struct SectorContactPair {
+  int high_node = -1;   ///< q: shroud_high node of the reference sector
+  int low_node = -1;    ///< p: its matched shroud_low node (x_q = R x_p)
+  Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();  ///< rows t1, t2, n (n outward of shroud_high)
+};
+
+struct SectorForcing {
+  int engine_order = 1;              ///< m: harmonic n lives in h = n m mod Nb
+  int excitation_node = -1;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< amplitude [N], global x y z (harmonic 1)
+  int response_node = -1;
+  double damping_ratio = 0.001;      ///< modal damping of every mode
+  bool residual_flexibility = true;
+};
+
+class SectorLinearPart : public LinearPart {
+ public:
+  /// bases: the modes of every h_n needed (n = 0..H); factor(h): K_h factorization.
+  /// Precomputes, per harmonic index, the projections of the modes on C and the static
+  /// (residual) flexibility blocks: after construction each harmonic costs O(k^2 modes).
+  SectorLinearPart(const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
+                   const std::function<modal::StiffnessFactor(int)>& factor, std::vector<SectorContactPair> pairs,
+                   SectorForcing forcing, int n_harmonics);
+
+  int n_contact() const override { return 3 * static_cast<int>(pairs_.size()); }
+  int n_response() const override { return 3; }
+  void harmonic(int n, double w, HarmonicReceptance& out) const override;
+  void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
+              double& viscous_dissipation) const override;
+  std::string describe() const override;
+
+  /// Harmonic index of temporal harmonic n.
+  int harmonic_index(int n) const;
+
+ private:
+  struct IndexData {
+    Eigen::VectorXd omega;       ///< modes kept [rad/s]
+    Eigen::MatrixXcd psi;        ///< k x modes: C T_h phi
+    Eigen::MatrixXcd flex;       ///< k x k: residual flexibility (n >= 1) or static flexibility (h used for n = 0)
+  };
+  /// Q_n(W) (k x k).
+  Eigen::MatrixXcd receptance(int n, double w) const;
+
+  std::vector<SectorContactPair> pairs_;
+  SectorForcing forcing_;
+  int sectors_ = 1, n_harmonics_ = 0;
+  std::map<int, IndexData> dynamic_;   ///< per harmonic index of n >= 1
+  IndexData static_;                   ///< n = 0 (h = 0): exact static flexibility in flex
+};
+
+}  // namespace shroudsim::frf

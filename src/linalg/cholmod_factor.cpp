@@ -1,0 +1,93 @@
+#include "linalg/cholmod_factor.hpp"
+
+#include <Eigen/CholmodSupport>
+
+#include "core/error.hpp"
+
+namespace shroudsim::linalg {
+
+std::string to_string(FactorStatus status) {
+  switch (status) {
+    case FactorStatus::Success: return "success";
+    case FactorStatus::NotPositiveDefinite: return "not positive definite";
+    case FactorStatus::Failed: return "CHOLMOD failure";
+  }
+  return "unknown";
+}
+
+template <typename Scalar>
+struct CholmodFactor<Scalar>::Impl {
+  Eigen::CholmodDecomposition<SparseMatrix<Scalar>, Eigen::Lower> llt;
+};
+
+template <typename Scalar>
+CholmodFactor<Scalar>::CholmodFactor(FactorMethod method) : impl_(std::make_unique<Impl>()) {
+  impl_->llt.setMode(method == FactorMethod::Supernodal ? Eigen::CholmodSupernodalLLt
+                                                        : Eigen::CholmodSimplicialLLt);
+  cholmod_common& c = impl_->llt.cholmod();
+  c.print = 0;                         // failures are reported through status(), not stderr
+  c.quick_return_if_not_posdef = 1;
+}
+
+template <typename Scalar>
+CholmodFactor<Scalar>::~CholmodFactor() = default;
+template <typename Scalar>
+CholmodFactor<Scalar>::CholmodFactor(CholmodFactor&&) noexcept = default;
+template <typename Scalar>
+CholmodFactor<Scalar>& CholmodFactor<Scalar>::operator=(CholmodFactor&&) noexcept = default;
+
+template <typename Scalar>
+void CholmodFactor<Scalar>::analyze(const SparseMatrix<Scalar>& A) {
+  SHROUDSIM_CHECK(A.rows() == A.cols(), "CholmodFactor: matrix must be square");
+  SHROUDSIM_CHECK(A.isCompressed(), "CholmodFactor: matrix must be compressed");
+  rows_ = A.rows();
+  impl_->llt.analyzePattern(A);
+  status_ = impl_->llt.info() == Eigen::Success ? FactorStatus::Success : FactorStatus::Failed;
+}
+
+template <typename Scalar>
+FactorStatus CholmodFactor<Scalar>::factorize(const SparseMatrix<Scalar>& A) {
+  SHROUDSIM_CHECK(A.rows() == rows_ && A.cols() == rows_, "CholmodFactor: size changed after analyze");
+  impl_->llt.factorize(A);
+  switch (impl_->llt.info()) {
+    case Eigen::Success: status_ = FactorStatus::Success; break;
+    case Eigen::NumericalIssue: status_ = FactorStatus::NotPositiveDefinite; break;
+    default: status_ = FactorStatus::Failed; break;
+  }
+  // CHOLMOD reports "not positive definite" through Common.status as well.
+  if (status_ == FactorStatus::Success && impl_->llt.cholmod().status == CHOLMOD_NOT_POSDEF)
+    status_ = FactorStatus::NotPositiveDefinite;
+  return status_;
+}
+
+template <typename Scalar>
+FactorStatus CholmodFactor<Scalar>::compute(const SparseMatrix<Scalar>& A) {
+  analyze(A);
+  if (status_ != FactorStatus::Success) return status_;
+  return factorize(A);
+}
+
+template <typename Scalar>
+typename CholmodFactor<Scalar>::Matrix CholmodFactor<Scalar>::solve(const Matrix& b) const {
+  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve without a valid factor");
+  SHROUDSIM_CHECK(b.rows() == rows_, "CholmodFactor::solve: right-hand side has the wrong size");
+  return impl_->llt.solve(b);
+}
+
+template <typename Scalar>
+void CholmodFactor<Scalar>::solve(const Scalar* b, Scalar* x) const {
+  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve without a valid factor");
+  Eigen::Map<const Vector> bm(b, rows_);
+  Eigen::Map<Vector> xm(x, rows_);
+  xm = impl_->llt.solve(Vector(bm));
+}
+
+template <typename Scalar>
+double CholmodFactor<Scalar>::factor_nonzeros() const {
+  return impl_->llt.cholmod().lnz;
+}
+
+template class CholmodFactor<double>;
+template class CholmodFactor<Complex>;
+
+}  // namespace shroudsim::linalg

@@ -1,0 +1,436 @@
+#include "modal/eigensolver.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Spectra/SymGEigsShiftSolver.h>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+
+namespace shroudsim::modal {
+
+using linalg::SparseMatrixC;
+using linalg::SparseMatrixD;
+
+bool ModalOptions::validate(std::vector<std::string>* errors) const {
+  const auto n0 = errors ? errors->size() : 0;
+  auto fail = [&](const std::string& m) {
+    if (errors) errors->push_back(m);
+  };
+  if (modes < 1) fail("modes = " + std::to_string(modes) + " violates: modes >= 1");
+  if (!std::isfinite(shift)) fail("shift must be finite");
+  if (ncv < 0) fail("ncv must be >= 0");
+  if (max_restarts < 1) fail("max_restarts must be >= 1");
+  if (!(tolerance > 0.0 && tolerance < 1e-2)) fail("tolerance must be in (0, 1e-2)");
+  if (!(residual_tolerance > 0.0 && residual_tolerance < 1.0)) fail("residual_tolerance must be in (0, 1)");
+  return !errors || errors->size() == n0;
+}
+
+Eigen::VectorXd ModalBasis::frequency_hz() const { return omega / (2.0 * M_PI); }
+
+ModalBasis ModalBasis::conjugate(int new_harmonic_index) const {
+  return {new_harmonic_index, omega, phi.conjugate()};
+}
+
+std::string to_string(ModalStatus status) {
+  switch (status) {
+    case ModalStatus::Converged: return "converged";
+    case ModalStatus::FactorizationFailed: return "factorization failed";
+    case ModalStatus::NotConverged: return "not converged";
+    case ModalStatus::ResidualTooLarge: return "residual too large";
+    case ModalStatus::TooFewModes: return "too few modes";
+  }
+  return "unknown";
+}
+
+// ---------------------------------------------------------------------------------------------
+// StiffnessFactor
+
+StiffnessFactor::StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>> real)
+    : real_(std::move(real)) {}
+StiffnessFactor::StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>> complex, bool conjugated)
+    : complex_(std::move(complex)), conjugated_(conjugated) {}
+
+Eigen::Index StiffnessFactor::rows() const {
+  return real_ ? real_->rows() : complex_ ? complex_->rows() : 0;
+}
+
+Eigen::MatrixXcd StiffnessFactor::solve(const Eigen::MatrixXcd& b) const {
+  SHROUDSIM_CHECK(valid(), "StiffnessFactor::solve without a factor");
+  if (real_) {
+    Eigen::MatrixXd parts(b.rows(), 2 * b.cols());
+    parts << b.real(), b.imag();
+    const Eigen::MatrixXd x = real_->solve(parts);
+    Eigen::MatrixXcd out(b.rows(), b.cols());
+    out.real() = x.leftCols(b.cols());
+    out.imag() = x.rightCols(b.cols());
+    return out;
+  }
+  if (conjugated_) return complex_->solve(b.conjugate()).conjugate();
+  return complex_->solve(b);
+}
+
+StiffnessFactor StiffnessFactor::conjugate() const {
+  if (real_) return *this;
+  return StiffnessFactor(complex_, !conjugated_);
+}
+
+template <typename Scalar>
+static StiffnessFactor factor_stiffness_impl(const linalg::SparseMatrix<Scalar>& K, linalg::FactorMethod method) {
+  auto f = std::make_shared<linalg::CholmodFactor<Scalar>>(method);
+  const auto status = f->compute(K);
+  if (status != linalg::FactorStatus::Success)
+    throw NumericalError("factorization of the stiffness matrix failed: " + linalg::to_string(status));
+  if constexpr (std::is_same_v<Scalar, double>)
+    return StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>>(f));
+  else
+    return StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(f), false);
+}
+
+StiffnessFactor factor_stiffness(const SparseMatrixD& K, linalg::FactorMethod method) {
+  return factor_stiffness_impl(K, method);
+}
+StiffnessFactor factor_stiffness(const SparseMatrixC& K, linalg::FactorMethod method) {
+  return factor_stiffness_impl(K, method);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Spectra operators on the real representation (n for real, 2n = [Re; Im] for complex).
+
+namespace {
+
+template <typename S>
+constexpr bool kIsComplex = !std::is_same_v<S, double>;
+
+/// y = (K - sigma M)^{-1} x; set_shift factorizes (symbolic analysis once).
+template <typename S>
+class ShiftInvertOp {
+ public:
+  using Scalar = double;
+  ShiftInvertOp(const linalg::SparsePair<S>& km, linalg::FactorMethod method)
+      : km_(km), n_(km.K.rows()), factor_(std::make_shared<linalg::CholmodFactor<S>>(method)), z_(n_), w_(n_) {}
+  Eigen::Index rows() const { return kIsComplex<S> ? 2 * n_ : n_; }
+  Eigen::Index cols() const { return rows(); }
+  void set_shift(double sigma) {
+    log::Stopwatch watch;
+    linalg::SparseMatrix<S> A = sigma == 0.0 ? linalg::SparseMatrix<S>(km_.K)
+                                             : linalg::SparseMatrix<S>(km_.K - S(sigma) * km_.M);
+    A.makeCompressed();
+    status_ = factor_->compute(A);
+    sigma_ = sigma;
+    seconds_ = watch.seconds();
+  }
+  void perform_op(const double* x, double* y) const {
+    if constexpr (kIsComplex<S>) {
+      for (Eigen::Index i = 0; i < n_; ++i) z_[i] = S(x[i], x[n_ + i]);
+      factor_->solve(z_.data(), w_.data());
+      for (Eigen::Index i = 0; i < n_; ++i) {
+        y[i] = w_[i].real();
+        y[n_ + i] = w_[i].imag();
+      }
+    } else {
+      factor_->solve(x, y);
+    }
+  }
+  linalg::FactorStatus status() const { return status_; }
+  double sigma() const { return sigma_; }
+  double seconds() const { return seconds_; }
+  const std::shared_ptr<linalg::CholmodFactor<S>>& factor() const { return factor_; }
+
+ private:
+  const linalg::SparsePair<S>& km_;
+  Eigen::Index n_;
+  std::shared_ptr<linalg::CholmodFactor<S>> factor_;
+  linalg::FactorStatus status_ = linalg::FactorStatus::Failed;
+  double sigma_ = 0.0, seconds_ = 0.0;
+  mutable Eigen::Matrix<S, Eigen::Dynamic, 1> z_, w_;
+};
+
+/// y = M x on the real representation. For complex M = Mr + i Mi (Mi holds only the few
+/// couplings across the cyclic boundary), [a; b] -> [Mr a - Mi b; Mr b + Mi a] with one pass
+/// over the real Mr for both halves: Lanczos calls this several times per step.
+template <typename S>
+class MassOp {
+ public:
+  using Scalar = double;
+  explicit MassOp(const linalg::SparseMatrix<S>& M) : n_(M.rows()) {
+    if constexpr (kIsComplex<S>) {
+      Mr_ = M.real();
+      Mi_ = M.imag();
+      Mi_.prune(0.0);
+      Mr_.makeCompressed();
+      Mi_.makeCompressed();
+    } else {
+      Mr_ = M;
+    }
+  }
+  Eigen::Index rows() const { return kIsComplex<S> ? 2 * n_ : n_; }
+  Eigen::Index cols() const { return rows(); }
+  void perform_op(const double* x, double* y) const {
+    ++products_;
+    if constexpr (kIsComplex<S>) {
+      const double* a = x;
+      const double* b = x + n_;
+      double* ya = y;
+      double* yb = y + n_;
+      std::fill(y, y + 2 * n_, 0.0);
+      const int* outer = Mr_.outerIndexPtr();
+      const int* inner = Mr_.innerIndexPtr();
+      const double* val = Mr_.valuePtr();
+      for (Eigen::Index j = 0; j < n_; ++j) {
+        const double aj = a[j], bj = b[j];
+        for (int k = outer[j]; k < outer[j + 1]; ++k) {
+          ya[inner[k]] += val[k] * aj;
+          yb[inner[k]] += val[k] * bj;
+        }
+      }
+      for (Eigen::Index j = 0; j < n_; ++j)
+        for (linalg::SparseMatrixD::InnerIterator it(Mi_, j); it; ++it) {
+          ya[it.row()] -= it.value() * b[j];
+          yb[it.row()] += it.value() * a[j];
+        }
+    } else {
+      Eigen::Map<Eigen::VectorXd>(y, n_).noalias() = Mr_ * Eigen::Map<const Eigen::VectorXd>(x, n_);
+    }
+  }
+  long products() const { return products_; }
+
+ private:
+  Eigen::Index n_;
+  linalg::SparseMatrixD Mr_, Mi_;
+  mutable long products_ = 0;
+};
+
+// Problems up to this size go to a dense solver (Lanczos brings nothing there).
+constexpr Eigen::Index kDenseThreshold = 300;
+
+// Two Ritz values belong to one group (one physical eigenvalue, possibly several modes)
+// when they agree to this relative tolerance; a group is then resolved by Rayleigh-Ritz,
+// so a loose value only costs a few sparse products.
+constexpr double kGroupRelTol = 1e-6;
+// Complex rank of a group: eigenvalues of its Euclidean Gram matrix below this fraction of
+// the largest are copies (i z of a z already present). Copies agree to ~sqrt(tolerance);
+// distinct modes give O(1).
+constexpr double kRankRelTol = 1e-4;
+
+template <typename S>
+using MatrixS = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+
+// Explicit residual check; fills report.max_residual and returns false if above tolerance.
+template <typename S>
+bool check_residuals(const linalg::SparsePair<S>& km, const Eigen::VectorXd& lambda, const MatrixS<S>& phi,
+                     const ModalOptions& options, ModalReport& report) {
+  report.max_residual = 0.0;
+  int worst = -1;
+  // K and M are symmetric/Hermitian and stored in full, so K^H (a row-major view of the same
+  // storage) multiplies all modes in one pass over the matrix.
+  const MatrixS<S> KP = km.K.adjoint() * phi;
+  const MatrixS<S> MP = km.M.adjoint() * phi;
+  for (Eigen::Index j = 0; j < phi.cols(); ++j) {
+    const double denom = std::max(KP.col(j).norm(), std::numeric_limits<double>::min());
+    const double rel = (KP.col(j) - lambda(j) * MP.col(j)).norm() / denom;
+    if (!(rel <= report.max_residual)) {
+      report.max_residual = std::isfinite(rel) ? rel : std::numeric_limits<double>::infinity();
+      worst = static_cast<int>(j);
+    }
+  }
+  if (!(report.max_residual <= options.residual_tolerance)) {
+    report.status = ModalStatus::ResidualTooLarge;
+    report.message = "mode " + std::to_string(worst + 1) + " has relative residual " +
+                     std::to_string(report.max_residual) + " > " + std::to_string(options.residual_tolerance);
+    return false;
+  }
+  return true;
+}
+
+template <typename S>
+ModalResult finish(const linalg::SparsePair<S>& km, int h, Eigen::VectorXd lambda, MatrixS<S> phi,
+                   const ModalOptions& options, ModalReport report) {
+  // Ascending order, lowest `modes`.
+  std::vector<Eigen::Index> order(lambda.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](auto a, auto b) { return lambda(a) < lambda(b); });
+  const Eigen::Index k = std::min<Eigen::Index>(options.modes, lambda.size());
+  ModalResult result;
+  result.report = std::move(report);
+  Eigen::VectorXd lam(k);
+  MatrixS<S> vec(phi.rows(), k);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    lam(j) = lambda(order[j]);
+    vec.col(j) = phi.col(order[j]);
+  }
+  if (k < options.modes && result.report.status == ModalStatus::Converged) {
+    if (phi.rows() <= k) {
+      result.report.message = "only " + std::to_string(k) + " modes exist (" + std::to_string(phi.rows()) +
+                              " DOFs); " + std::to_string(options.modes) + " were asked for";
+    } else {
+      result.report.status = ModalStatus::TooFewModes;
+      result.report.message = "found " + std::to_string(k) + " distinct modes, " +
+                              std::to_string(options.modes) + " were asked for";
+    }
+  }
+  if (!result.report.ok()) return result;
+  if (!check_residuals(km, lam, vec, options, result.report)) return result;
+  result.basis.harmonic_index = h;
+  result.basis.omega = lam.cwiseMax(0.0).cwiseSqrt();
+  if constexpr (kIsComplex<S>)
+    result.basis.phi = vec;
+  else
+    result.basis.phi = vec.template cast<Complex>();
+  return result;
+}
+
+template <typename S>
+ModalResult solve_dense(const linalg::SparsePair<S>& km, int h, const ModalOptions& options) {
+  ModalReport report;
+  report.method = "dense";
+  log::Stopwatch watch;
+  const MatrixS<S> K(km.K), M(km.M);
+  Eigen::GeneralizedSelfAdjointEigenSolver<MatrixS<S>> es(K - S(options.shift) * M, M);
+  report.solve_seconds = watch.seconds();
+  if (es.info() != Eigen::Success) {
+    report.status = ModalStatus::NotConverged;
+    report.message = "dense generalized eigensolver failed";
+    ModalResult r;
+    r.report = report;
+    return r;
+  }
+  Eigen::VectorXd lambda = es.eigenvalues().array() + options.shift;
+  return finish<S>(km, h, lambda, es.eigenvectors(), options, report);
+}
+
+template <typename S>
+ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOptions& options) {
+  const Eigen::Index n = km.K.rows();
+  const Eigen::Index real_n = kIsComplex<S> ? 2 * n : n;
+  ModalReport report;
+  report.method = kIsComplex<S> ? "spectra-complex-2n" : "spectra-real";
+  ShiftInvertOp<S> op(km, options.factor_method);
+  MassOp<S> bop(km.M);
+  const Eigen::Index nev = std::min<Eigen::Index>(kIsComplex<S> ? 2 * options.modes + 4 : options.modes, real_n - 1);
+  Eigen::Index ncv = options.ncv > 0 ? options.ncv : std::max<Eigen::Index>(2 * nev + 1, nev + 20);
+  ncv = std::min(std::max(ncv, nev + 1), real_n);
+  report.requested_eigenvalues = static_cast<int>(nev);
+
+  using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOp<S>, MassOp<S>, Spectra::GEigsMode::ShiftInvert>;
+  Solver solver(op, bop, nev, ncv, options.shift);  // calls op.set_shift: the factorization
+  report.factor_seconds = op.seconds();
+  report.factor_nonzeros = op.factor()->factor_nonzeros();
+  if (op.status() != linalg::FactorStatus::Success) {
+    report.status = ModalStatus::FactorizationFailed;
+    report.message = "CHOLMOD factorization of K - sigma M (sigma = " + std::to_string(options.shift) +
+                     ") failed: " + linalg::to_string(op.status());
+    ModalResult r;
+    r.report = report;
+    return r;
+  }
+  log::Stopwatch watch;
+  solver.init();
+  const Eigen::Index nconv = solver.compute(Spectra::SortRule::LargestMagn, options.max_restarts, options.tolerance);
+  report.solve_seconds = watch.seconds();
+  report.spectra_info = static_cast<int>(solver.info());
+  report.converged_eigenvalues = static_cast<int>(nconv);
+  report.iterations = static_cast<int>(solver.num_iterations());
+  report.operations = static_cast<int>(solver.num_operations());
+  report.mass_products = static_cast<int>(bop.products());
+  if (solver.info() != Spectra::CompInfo::Successful || nconv < nev) {
+    report.status = ModalStatus::NotConverged;
+    report.message = "Spectra SymGEigsShiftSolver: " + std::to_string(nconv) + " of " + std::to_string(nev) +
+                     " eigenvalues converged after " + std::to_string(report.iterations) +
+                     " restarts (CompInfo " + std::to_string(report.spectra_info) + ")";
+    ModalResult r;
+    r.report = report;
+    return r;
+  }
+  const Eigen::VectorXd ritz = solver.eigenvalues();
+  const Eigen::MatrixXd X = solver.eigenvectors();
+
+  ModalResult result;
+  if constexpr (!kIsComplex<S>) {
+    result = finish<S>(km, h, ritz, X, options, report);
+  } else {
+    // Back to complex vectors; each physical mode may appear up to twice (z and i z).
+    const Eigen::MatrixXcd Z = X.topRows(n).template cast<Complex>() + Complex(0, 1) * X.bottomRows(n).template cast<Complex>();
+    std::vector<Eigen::Index> order(ritz.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](auto a, auto b) { return ritz(a) < ritz(b); });
+    const double scale = ritz.cwiseAbs().maxCoeff();
+    std::vector<double> lam;
+    std::vector<Eigen::VectorXcd> vecs;
+    for (std::size_t g0 = 0; g0 < order.size();) {
+      std::size_t g1 = g0 + 1;
+      while (g1 < order.size() &&
+             std::abs(ritz(order[g1]) - ritz(order[g0])) <= kGroupRelTol * std::max(std::abs(ritz(order[g0])), 1e-12 * scale))
+        ++g1;
+      const auto size = static_cast<Eigen::Index>(g1 - g0);
+      if (size == 1) {
+        // x^T M_2n x = 1 gives z^H M z = 1: already mass-normalised.
+        lam.push_back(ritz(order[g0]));
+        vecs.push_back(Z.col(order[g0]));
+      } else {
+        Eigen::MatrixXcd Zg(n, size);
+        for (Eigen::Index j = 0; j < size; ++j) Zg.col(j) = Z.col(order[g0 + j]);
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXcd> gram(Zg.adjoint() * Zg);
+        const Eigen::VectorXd g = gram.eigenvalues();  // ascending
+        Eigen::Index rank = 0;
+        for (Eigen::Index j = 0; j < size; ++j) rank += g(j) > kRankRelTol * g(size - 1);
+        if (rank == 1) {
+          lam.push_back(ritz(order[g0]));
+          vecs.push_back(Zg.col(0));
+        } else {
+          // Several physical modes: Rayleigh-Ritz on the group's complex span.
+          const Eigen::MatrixXcd W = Zg * gram.eigenvectors().rightCols(rank);
+          const Eigen::MatrixXcd MW = km.M * W, KW = km.K * W;
+          Eigen::MatrixXcd Gm = W.adjoint() * MW, Km = W.adjoint() * KW;
+          Gm = 0.5 * (Gm + Gm.adjoint()).eval();
+          Km = 0.5 * (Km + Km.adjoint()).eval();
+          Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXcd> rr(Km, Gm);
+          for (Eigen::Index j = 0; j < rank; ++j) {
+            lam.push_back(rr.eigenvalues()(j));
+            vecs.push_back(W * rr.eigenvectors().col(j));
+          }
+        }
+      }
+      g0 = g1;
+    }
+    Eigen::VectorXd lambda = Eigen::Map<const Eigen::VectorXd>(lam.data(), static_cast<Eigen::Index>(lam.size()));
+    Eigen::MatrixXcd phi(n, static_cast<Eigen::Index>(vecs.size()));
+    for (std::size_t j = 0; j < vecs.size(); ++j) phi.col(static_cast<Eigen::Index>(j)) = vecs[j];
+    result = finish<S>(km, h, lambda, phi, options, report);
+  }
+  if (result.report.ok() && options.shift == 0.0) {
+    if constexpr (kIsComplex<S>)
+      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(op.factor()), false);
+    else
+      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>>(op.factor()));
+  }
+  return result;
+}
+
+template <typename S>
+ModalResult solve_any(const linalg::SparsePair<S>& km, int h, const ModalOptions& options) {
+  std::vector<std::string> errors;
+  SHROUDSIM_CHECK(options.validate(&errors), errors.empty() ? "invalid ModalOptions" : errors.front());
+  SHROUDSIM_CHECK(km.K.rows() == km.K.cols() && km.M.rows() == km.K.rows() && km.M.cols() == km.K.rows(),
+                  "solve_modes: K and M must be square and of equal size");
+  SHROUDSIM_CHECK(km.K.rows() > 0, "solve_modes: empty problem (every DOF clamped?)");
+  const Eigen::Index n = km.K.rows();
+  const Eigen::Index real_n = kIsComplex<S> ? 2 * n : n;
+  const Eigen::Index nev = kIsComplex<S> ? 2 * options.modes + 4 : options.modes;
+  if (n <= kDenseThreshold || nev + 1 >= real_n) return solve_dense<S>(km, h, options);
+  return solve_spectra<S>(km, h, options);
+}
+
+}  // namespace
+
+ModalResult solve_modes(const linalg::SparsePair<double>& km, int h, const ModalOptions& options) {
+  return solve_any<double>(km, h, options);
+}
+
+ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int h, const ModalOptions& options) {
+  return solve_any<Complex>(km, h, options);
+}
+
+}  // namespace shroudsim::modal

@@ -1,0 +1,119 @@
+#pragma once
+// Lowest modes of K phi = w^2 M phi (real symmetric, or complex Hermitian from the cyclic
+// reduction), by Spectra's shift-invert Lanczos (SymGEigsShiftSolver) on a CHOLMOD
+// factorization of K - sigma M.
+//
+// Complex Hermitian problems are solved through the real symmetric 2n embedding
+//   [Re K  -Im K] [a]       [Re M  -Im M] [a]
+//   [Im K   Re K] [b] = w^2 [Im M   Re M] [b],     z = a + i b,
+// whose operator applies one complex CHOLMOD solve of K - sigma M (cheaper than factoring
+// the 2n real matrix). Every physical mode z appears twice there ([a; b] and the
+// embedding of i z, [-b; a]); Spectra is asked for 2 * modes + 4 eigenvalues, the Ritz
+// vectors are mapped back to complex vectors, grouped by eigenvalue, and each group's
+// complex span is reduced to its physical modes (M-orthonormalised, Rayleigh-Ritz when a
+// group holds more than one physical mode). Each mode is returned once.
+//
+// Every returned mode is checked: ||K phi - w^2 M phi|| <= residual_tolerance * ||K phi||.
+// Failure (factorization, Spectra not converging, residual too large, too few modes) is
+// reported in ModalReport (status + message), never by silently returning modes.
+//
+// Units: K in N/m, M in kg, omega in rad/s, shift in (rad/s)^2.
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "linalg/cholmod_factor.hpp"
+#include "linalg/sparse.hpp"
+
+namespace shroudsim::modal {
+
+using linalg::Complex;
+
+struct ModalOptions {
+  int modes = 50;                  ///< lowest modes wanted per problem (>= 1)
+  double shift = 0.0;              ///< sigma [(rad/s)^2]; 0 factors K itself (kept for static solves).
+                                   ///< Use sigma < 0 for an unclamped (singular) K.
+  int ncv = 0;                     ///< Lanczos basis size; 0: max(2 nev + 1, nev + 20)
+  int max_restarts = 1000;         ///< Spectra maxit
+  double tolerance = 1e-10;        ///< Spectra's relative tolerance on the Ritz values
+  double residual_tolerance = 1e-6;  ///< accepted ||K phi - w^2 M phi|| / ||K phi||
+  linalg::FactorMethod factor_method = linalg::FactorMethod::Supernodal;
+  /// Returns false and appends messages if a value is out of range.
+  bool validate(std::vector<std::string>* errors) const;
+};
+
+/// Mass-normalised modes of one harmonic index, on the reduced DOFs of that index.
+struct ModalBasis {
+  int harmonic_index = 0;
+  Eigen::VectorXd omega;  ///< rad/s, ascending, >= 0
+  Eigen::MatrixXcd phi;   ///< n_reduced x n_modes, phi^H M_h phi = I
+  int size() const { return static_cast<int>(omega.size()); }
+  Eigen::VectorXd frequency_hz() const;
+  /// The basis of harmonic index new_h = Nb - h: conj(phi), same omega.
+  ModalBasis conjugate(int new_harmonic_index) const;
+};
+
+enum class ModalStatus {
+  Converged,
+  FactorizationFailed,  ///< K - sigma M not positive definite (sigma above the lowest mode, or K singular)
+  NotConverged,         ///< Spectra stopped with unconverged Ritz pairs
+  ResidualTooLarge,     ///< a returned pair fails the explicit residual check
+  TooFewModes           ///< fewer distinct modes than asked for were found
+};
+std::string to_string(ModalStatus status);
+
+struct ModalReport {
+  ModalStatus status = ModalStatus::Converged;
+  std::string message;            ///< empty when converged
+  std::string method;             ///< "spectra-real", "spectra-complex-2n" or "dense"
+  int spectra_info = 0;           ///< Spectra::CompInfo as int (0 = Successful)
+  int requested_eigenvalues = 0;  ///< nev asked of Spectra
+  int converged_eigenvalues = 0;  ///< nconv
+  int iterations = 0;             ///< Spectra restarts
+  int operations = 0;             ///< operator applications (solves)
+  int mass_products = 0;          ///< products with M (operator and M-inner products)
+  double max_residual = 0.0;      ///< max relative residual of the returned modes
+  double factor_nonzeros = 0.0;
+  double factor_seconds = 0.0, solve_seconds = 0.0;
+  bool ok() const { return status == ModalStatus::Converged; }
+};
+
+/// A kept factorization of K (real or complex Hermitian) for static solves K x = b with
+/// complex right-hand sides; `conjugated` solves with conj(K) (harmonic index Nb - h).
+class StiffnessFactor {
+ public:
+  StiffnessFactor() = default;
+  explicit StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>> real);
+  StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>> complex, bool conjugated);
+  bool valid() const { return real_ || complex_; }
+  Eigen::Index rows() const;
+  /// x = K^{-1} b (columns).
+  Eigen::MatrixXcd solve(const Eigen::MatrixXcd& b) const;
+  /// The factor of conj(K) (for Nb - h), sharing the same CHOLMOD factor.
+  StiffnessFactor conjugate() const;
+
+ private:
+  std::shared_ptr<const linalg::CholmodFactor<double>> real_;
+  std::shared_ptr<const linalg::CholmodFactor<Complex>> complex_;
+  bool conjugated_ = false;
+};
+
+/// Factorizes K (throws NumericalError if it is not positive definite).
+StiffnessFactor factor_stiffness(const linalg::SparseMatrixD& K,
+                                 linalg::FactorMethod method = linalg::FactorMethod::Supernodal);
+StiffnessFactor factor_stiffness(const linalg::SparseMatrixC& K,
+                                 linalg::FactorMethod method = linalg::FactorMethod::Supernodal);
+
+struct ModalResult {
+  ModalBasis basis;           ///< the converged modes (empty unless report.ok())
+  ModalReport report;
+  StiffnessFactor stiffness;  ///< the factor of K when shift == 0 and it succeeded
+};
+
+/// Lowest options.modes modes of a real symmetric pair (basis.phi is real-valued).
+ModalResult solve_modes(const linalg::SparsePair<double>& km, int harmonic_index, const ModalOptions& options);
+/// Lowest options.modes modes of a complex Hermitian pair (real 2n embedding).
+ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int harmonic_index, const ModalOptions& options);
+
+}  // namespace shroudsim::modal

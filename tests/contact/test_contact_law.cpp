@@ -1,0 +1,250 @@
+// Time-domain contact laws of one pair (no FFT): the exact_linear step, stick, separation,
+// steady-state iteration, frame invariance, input validation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "contact/contact_law.hpp"
+
+namespace {
+
+using shroudsim::contact::LawOptions;
+using shroudsim::contact::Model;
+using shroudsim::contact::PairParameters;
+using shroudsim::contact::PeriodicLaw;
+using shroudsim::contact::TangentialUpdate;
+constexpr double kPi = std::numbers::pi;
+
+// Round-off of a few dozen operations on O(1) numbers.
+constexpr double kRoundOff = 1e-12;
+
+Eigen::MatrixX3d orbit(int n, double ax, double ay, double phase_y, double z0, double az) {
+  Eigen::MatrixX3d w(n, 3);
+  for (int l = 0; l < n; ++l) {
+    const double t = 2.0 * kPi * l / n;
+    w(l, 0) = ax * std::cos(t);
+    w(l, 1) = ay * std::sin(t + phase_y);
+    w(l, 2) = z0 + az * std::cos(2.0 * t);
+  }
+  return w;
+}
+
+TEST(ExactLinearStep, JacobianMatchesCentralDifferences) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  // Central differences at h = 1e-7 on O(1) data: O(h^2) + eps/h ~ 1e-9; states where the
+  // stick/slip switch falls inside the difference step are rare and only bounded.
+  constexpr double kH = 1e-7, kTol = 1e-6;
+  int good = 0;
+  constexpr int kStates = 200;
+  for (int k = 0; k < kStates; ++k) {
+    const double a0 = 0.5 + 0.5 * std::abs(u(rng)), a1 = 0.5 + 0.5 * std::abs(u(rng));
+    Eigen::Vector2d e0(u(rng), u(rng));
+    if (e0.norm() > a0) e0 *= a0 / e0.norm() * std::abs(u(rng));
+    const Eigen::Vector2d dw(1.5 * u(rng), 1.5 * u(rng));
+    Eigen::Matrix<double, 2, 6> jac, fd;
+    shroudsim::contact::exact_linear_step(e0, dw, a0, a1, &jac);
+    for (int c = 0; c < 6; ++c) {
+      auto eval = [&](double step) {
+        Eigen::Vector2d e = e0, d = dw;
+        double b0 = a0, b1 = a1;
+        (c < 2 ? e[c] : c < 4 ? d[c - 2] : c == 4 ? b0 : b1) += step;
+        return shroudsim::contact::exact_linear_step(e, d, b0, b1);
+      };
+      fd.col(c) = (eval(kH) - eval(-kH)) / (2.0 * kH);
+    }
+    good += (jac - fd).norm() <= kTol * (1.0 + fd.norm());
+  }
+  EXPECT_GE(good, 0.97 * kStates);
+}
+
+// Exact integration composes: one step over [0, 1] equals two half steps, the radius linear
+// throughout (mid radius (a0 + a1)/2), for stick, stick-then-slip and slip from the start.
+TEST(ExactLinearStep, TwoHalfStepsEqualOneStep) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 100; ++k) {
+    const double a0 = 0.6 + 0.4 * std::abs(u(rng)), a1 = 0.6 + 0.4 * std::abs(u(rng));
+    Eigen::Vector2d e0(u(rng), u(rng));
+    if (e0.norm() > a0) e0 *= a0 / e0.norm();
+    const Eigen::Vector2d dw(2.0 * u(rng), 2.0 * u(rng));
+    const Eigen::Vector2d one = shroudsim::contact::exact_linear_step(e0, dw, a0, a1);
+    const double am = 0.5 * (a0 + a1);
+    const Eigen::Vector2d half = shroudsim::contact::exact_linear_step(e0, 0.5 * dw, a0, am);
+    const Eigen::Vector2d two = shroudsim::contact::exact_linear_step(half, 0.5 * dw, am, a1);
+    EXPECT_LE((one - two).norm(), 1e3 * kRoundOff) << "state " << k;  // tan/atan conditioning
+    EXPECT_LE(one.norm(), a1 * (1.0 + kRoundOff));
+  }
+}
+
+TEST(PeriodicLaw, PureStickIsALinearSpring) {
+  PairParameters p{.tangential_stiffness = 3e5, .normal_stiffness = 7e5,
+                   .friction_coefficient = 1e6, .normal_preload = 10.0};
+  const Eigen::MatrixX3d w = orbit(64, 2e-6, 1e-6, 0.3, 1e-6, 2e-6);
+  for (Model model : {Model::full3d, Model::quasi3d, Model::one_d}) {
+    for (auto update : {TangentialUpdate::radial_return, TangentialUpdate::exact_linear}) {
+      PeriodicLaw law({.model = model, .update = update});
+      Eigen::MatrixX3d f;
+      const auto st = law.evaluate(p, w, f);
+      EXPECT_TRUE(st.converged);
+      EXPECT_EQ(st.periods, 1);  // the damper never moves
+      for (int l = 0; l < 64; ++l) {
+        EXPECT_NEAR(f(l, 0), p.tangential_stiffness * w(l, 0), kRoundOff);
+        if (model != Model::one_d) {
+          EXPECT_NEAR(f(l, 1), p.tangential_stiffness * w(l, 1), kRoundOff);
+          EXPECT_NEAR(f(l, 2), p.normal_preload + p.normal_stiffness * w(l, 2), kRoundOff * 10);
+        }
+      }
+    }
+  }
+}
+
+TEST(PeriodicLaw, GapThatNeverClosesGivesZeroForceAndDerivative) {
+  PairParameters p{.tangential_stiffness = 3e5, .normal_stiffness = 7e5,
+                   .friction_coefficient = 0.3, .normal_preload = -1.0};
+  // |kn z| <= 7e5 * 1.2e-6 = 0.84 N < gap force 1 N.
+  const Eigen::MatrixX3d w = orbit(32, 1e-3, 1e-3, 0.0, 0.2e-6, 1e-6);
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Random(32, 3);
+  for (Model model : {Model::full3d, Model::quasi3d}) {
+    PeriodicLaw law({.model = model});
+    Eigen::MatrixX3d f;
+    shroudsim::contact::LinearizedPeriod lin;
+    law.evaluate(p, w, f, &basis, &lin);
+    EXPECT_EQ(f.norm(), 0.0);
+    std::array<shroudsim::contact::RowMatrix, 3> df;
+    lin.expand(basis, df);
+    for (const auto& d : df) EXPECT_EQ(d.norm(), 0.0);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_TRUE(lin.runs[i].empty());
+      EXPECT_TRUE(lin.dense_index[i].empty());
+    }
+  }
+}
+
+TEST(PeriodicLaw, OneDimensionalUpdatesAgreeAtConstantNormalLoad) {
+  // In 1D, clamping the trial force is the exact integration of a piecewise-linear motion.
+  PairParameters p{.tangential_stiffness = 1e5, .friction_coefficient = 0.5, .normal_preload = 2.0};
+  const Eigen::MatrixX3d w = orbit(100, 5e-5, 0.0, 0.0, 0.0, 0.0);
+  PeriodicLaw rr({.model = Model::one_d, .update = TangentialUpdate::radial_return});
+  PeriodicLaw el({.model = Model::one_d, .update = TangentialUpdate::exact_linear});
+  Eigen::MatrixX3d f1, f2;
+  rr.evaluate(p, w, f1);
+  el.evaluate(p, w, f2);
+  EXPECT_LE((f1 - f2).norm(), kRoundOff * f1.norm());
+}
+
+TEST(PeriodicLaw, SteadyStateIsFlaggedWhenTheCapIsHit) {
+  PairParameters p{.tangential_stiffness = 1e5, .friction_coefficient = 0.5, .normal_preload = 2.0};
+  const Eigen::MatrixX3d w = orbit(64, 5e-5, 3e-5, 0.4, 0.0, 0.0);
+  Eigen::MatrixX3d f;
+  PeriodicLaw capped({.model = Model::full3d, .max_periods = 1});
+  const auto s1 = capped.evaluate(p, w, f);
+  EXPECT_FALSE(s1.converged);  // from d = 0 the first period cannot be the steady one here
+  EXPECT_EQ(s1.periods, 1);
+  PeriodicLaw free({.model = Model::full3d});
+  const auto s2 = free.evaluate(p, w, f);
+  EXPECT_TRUE(s2.converged);
+  EXPECT_GE(s2.periods, 2);
+  EXPECT_TRUE(f.allFinite());
+}
+
+// The coupled law does not care how t1, t2 are turned about n; the uncoupled one does.
+TEST(PeriodicLaw, CoupledLawIsFrameInvariantUncoupledIsNot) {
+  PairParameters p{.tangential_stiffness = 1e5, .normal_stiffness = 2e5,
+                   .friction_coefficient = 0.5, .normal_preload = 2.0};
+  const Eigen::MatrixX3d w = orbit(128, 4e-5, 2e-5, 1.0, 2e-6, 4e-6);
+  const double psi = 0.7;
+  const double c = std::cos(psi), s = std::sin(psi);
+  Eigen::MatrixX3d wr = w;
+  wr.col(0) = c * w.col(0) - s * w.col(1);
+  wr.col(1) = s * w.col(0) + c * w.col(1);
+  auto rotated_difference = [&](Model model, TangentialUpdate update) {
+    PeriodicLaw law({.model = model, .update = update});
+    Eigen::MatrixX3d f, fr;
+    law.evaluate(p, w, f);
+    law.evaluate(p, wr, fr);
+    Eigen::MatrixX3d back = fr;
+    back.col(0) = c * fr.col(0) + s * fr.col(1);
+    back.col(1) = -s * fr.col(0) + c * fr.col(1);
+    return (back - f).norm() / f.norm();
+  };
+  // Steady-state tolerance 1e-12 relative and rotation round-off.
+  constexpr double kInvariant = 1e-9;
+  // Uncoupled: the friction limit applies per axis, a visible change (tens of percent here).
+  constexpr double kNotInvariant = 1e-2;
+  EXPECT_LE(rotated_difference(Model::full3d, TangentialUpdate::radial_return), kInvariant);
+  EXPECT_LE(rotated_difference(Model::full3d, TangentialUpdate::exact_linear), kInvariant);
+  EXPECT_GE(rotated_difference(Model::quasi3d, TangentialUpdate::radial_return), kNotInvariant);
+  EXPECT_GE(rotated_difference(Model::quasi3d, TangentialUpdate::exact_linear), kNotInvariant);
+}
+
+// The compact derivative of the time recursion, expanded sample by sample, against central
+// differences of the sampled forces, without any Fourier transform: unknowns c move the
+// samples along a random basis, w_j(l) = w0_j(l) + sum_k E(l, k) c_{j m + k}.
+TEST(PeriodicLaw, SampledDerivativeMatchesCentralDifferences) {
+  constexpr int kN = 48, kM = 5;
+  PairParameters p{.tangential_stiffness = 1e5, .normal_stiffness = 2e5,
+                   .friction_coefficient = 0.5, .normal_preload = 2.0};
+  // Amplitudes chosen so that no sample sits exactly on a stick/slip switch (a kink).
+  const Eigen::MatrixX3d w0 = orbit(kN, 4.3e-5, 3.1e-5, 0.8, 1e-6, 8e-6);  // partial separation
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd basis(kN, kM);
+  for (int l = 0; l < kN; ++l)
+    for (int k = 0; k < kM; ++k) basis(l, k) = u(rng);
+  // Central differences: O(h^2) + round-off (~1e-16 * 1e-5 m / 1e-11 m = 1e-10 relative);
+  // the state is away from kinks, so every column must agree.
+  constexpr double kH = 1e-11;  // m, against displacements of 1e-5 m
+  constexpr double kTol = 1e-6;
+  for (Model model : {Model::full3d, Model::quasi3d, Model::one_d}) {
+    for (auto update : {TangentialUpdate::radial_return, TangentialUpdate::exact_linear}) {
+      PeriodicLaw law({.model = model, .update = update});
+      const int dirs = shroudsim::contact::n_directions(model);
+      const int p_cols = dirs * kM;
+      Eigen::MatrixX3d f;
+      shroudsim::contact::LinearizedPeriod lin;
+      law.evaluate(p, w0, f, &basis, &lin);
+      std::array<shroudsim::contact::RowMatrix, 3> df;
+      lin.expand(basis, df);
+      int good = 0;
+      for (int c = 0; c < p_cols; ++c) {
+        Eigen::MatrixX3d wp = w0, wm = w0, fp, fm;
+        wp.col(c / kM) += kH * basis.col(c % kM);
+        wm.col(c / kM) -= kH * basis.col(c % kM);
+        law.evaluate(p, wp, fp);
+        law.evaluate(p, wm, fm);
+        const Eigen::MatrixX3d fd = (fp - fm) / (2.0 * kH);
+        double err = 0.0, ref = 0.0;
+        for (int i = 0; i < (dirs == 3 ? 3 : 1); ++i) {
+          err += (df[i].col(c) - fd.col(i)).squaredNorm();
+          ref += fd.col(i).squaredNorm();
+        }
+        good += std::sqrt(err) <= kTol * std::sqrt(ref) + 1e-300;
+      }
+      EXPECT_EQ(good, p_cols) << shroudsim::contact::to_string(model) << " "
+                                  << shroudsim::contact::to_string(update);
+    }
+  }
+}
+
+TEST(PairParameters, RefusesBadValuesNamingTheKey) {
+  auto first_error = [](PairParameters p, Model m) {
+    std::vector<std::string> e;
+    EXPECT_FALSE(p.validate(m, &e));
+    return e.empty() ? std::string() : e[0];
+  };
+  EXPECT_NE(first_error({.tangential_stiffness = 0.0}, Model::full3d).find("tangential_stiffness > 0"), std::string::npos);
+  EXPECT_NE(first_error({.normal_stiffness = -1.0}, Model::full3d).find("normal_stiffness > 0"), std::string::npos);
+  EXPECT_NE(first_error({.friction_coefficient = -0.1}, Model::quasi3d).find("friction_coefficient >= 0"), std::string::npos);
+  EXPECT_NE(first_error({.normal_preload = std::nan("")}, Model::full3d).find("normal_preload"), std::string::npos);
+  EXPECT_NE(first_error({.normal_preload = -1.0}, Model::one_d).find("normal_preload >= 0"), std::string::npos);
+  EXPECT_NE(first_error({.tangential_stiffness = INFINITY}, Model::one_d).find("tangential_stiffness"), std::string::npos);
+  std::vector<std::string> e;
+  EXPECT_TRUE(PairParameters{}.validate(Model::full3d, &e));
+  EXPECT_FALSE((LawOptions{.max_periods = 0}.validate(&e)));
+  EXPECT_THROW(PeriodicLaw({.model = Model::one_d_exact}), std::invalid_argument);
+}
+
+}  // namespace

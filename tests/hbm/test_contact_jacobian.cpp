@@ -1,0 +1,112 @@
+// The analytic contact Jacobian (differentiated time recursion, Fourier-projected) against
+// central differences of the same discrete map, for every model and both tangential
+// updates, over seeded random states. The full sweep (H = 1, 5, 15; N = 64, 512, 2048)
+// is bench/contact/contact_accuracy; this is its small version.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <tuple>
+
+#include "contact_test_support.hpp"
+#include "hbm/contact_evaluator.hpp"
+
+namespace {
+
+using shroudsim::contact::Model;
+using shroudsim::contact::TangentialUpdate;
+using shroudsim::hbm::ContactEvaluator;
+using shroudsim::hbm::JacobianMethod;
+
+// A central difference reproduces the exact derivative of a piecewise-smooth map to
+// O(h^2) + round-off (~1e-10 at h = 1e-6 relative), except for states where a sample
+// switches stick/slip/separation inside the step (measure zero, but random states hit it
+// now and then): the median must be tight, the worst case only bounded.
+constexpr double kMedianTol = 1e-7;
+constexpr double kShareTol = 1e-5;      // error bound met by ...
+constexpr double kShareRequired = 0.8;  // ... at least this share of the states
+
+class JacobianVsFd : public ::testing::TestWithParam<std::tuple<Model, TangentialUpdate, int, int>> {};
+
+TEST_P(JacobianVsFd, MatchesCentralDifferences) {
+  const auto [model, update, h, n] = GetParam();
+  shroudsim::contact::PairParameters p;
+  p.tangential_stiffness = 2.0e5;
+  p.normal_stiffness = 5.0e5;
+  p.friction_coefficient = 0.4;
+  p.normal_preload = 3.0;
+  shroudsim::hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = h;
+  o.n_time_samples = n;
+  o.law.model = model;
+  o.law.update = update;
+  o.measure_plans = false;
+  constexpr int kStates = 24;
+  ContactEvaluator ev(o, std::vector<shroudsim::contact::PairParameters>(kStates, p));
+  std::mt19937 rng(20261122);
+  Eigen::VectorXd w(ev.size());
+  for (int s = 0; s < kStates; ++s)
+    w.segment(s * ev.pair_layout().size(), ev.pair_layout().size()) =
+        shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
+  Eigen::VectorXd fa, ff;
+  std::vector<Eigen::MatrixXd> ja, jf;
+  const auto sa = ev.evaluate(w, fa, &ja, JacobianMethod::analytic);
+  ev.evaluate(w, ff, &jf, JacobianMethod::finite_difference);
+  EXPECT_EQ(sa.unconverged_pairs, 0);
+  EXPECT_EQ(fa, ff);  // the same residual whatever the Jacobian method
+  std::vector<double> err;
+  int within = 0;
+  for (int s = 0; s < kStates; ++s) {
+    ASSERT_TRUE(ja[s].allFinite());
+    err.push_back(shroudsim::testing::relative_error(ja[s], jf[s]));
+    within += err.back() <= kShareTol;
+  }
+  EXPECT_LE(shroudsim::testing::median(err), kMedianTol);
+  EXPECT_GE(within, kShareRequired * kStates);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Models, JacobianVsFd,
+    ::testing::Values(std::tuple{Model::full3d, TangentialUpdate::radial_return, 3, 64},
+                      std::tuple{Model::full3d, TangentialUpdate::exact_linear, 3, 64},
+                      std::tuple{Model::quasi3d, TangentialUpdate::radial_return, 3, 64},
+                      std::tuple{Model::quasi3d, TangentialUpdate::exact_linear, 3, 64},
+                      std::tuple{Model::one_d, TangentialUpdate::radial_return, 3, 64},
+                      std::tuple{Model::one_d, TangentialUpdate::exact_linear, 3, 64},
+                      std::tuple{Model::full3d, TangentialUpdate::exact_linear, 1, 256},
+                      std::tuple{Model::full3d, TangentialUpdate::radial_return, 5, 128},
+                      std::tuple{Model::one_d_exact, TangentialUpdate::exact_linear, 1, 64}));
+
+// Block diagonal and parallel: evaluating pairs together, threaded, equals one at a time.
+TEST(ContactEvaluator, PairsAreIndependentAndThreadingChangesNothing) {
+  shroudsim::contact::PairParameters p;
+  std::vector<shroudsim::contact::PairParameters> pairs(7, p);
+  for (int i = 0; i < 7; ++i) pairs[i].normal_preload = 0.1 + 0.2 * i;
+  shroudsim::hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = 3;
+  o.n_time_samples = 64;
+  o.measure_plans = false;
+  o.threads = 2;
+  ContactEvaluator par(o, pairs);
+  o.threads = 1;
+  ContactEvaluator ser(o, pairs);
+  std::mt19937 rng(7);
+  Eigen::VectorXd w(par.size());
+  const int s = par.pair_layout().size();
+  for (int i = 0; i < 7; ++i)
+    w.segment(i * s, s) = shroudsim::testing::random_contact_state(par.pair_layout(), pairs[i], rng);
+  Eigen::VectorXd f1, f2;
+  std::vector<Eigen::MatrixXd> j1, j2;
+  par.evaluate(w, f1, &j1);
+  ser.evaluate(w, f2, &j2);
+  EXPECT_EQ(f1, f2);
+  for (int i = 0; i < 7; ++i) EXPECT_EQ(j1[i], j2[i]);
+  // Pair 3 alone gives the same block.
+  ContactEvaluator one(o, {pairs[3]});
+  Eigen::VectorXd f3;
+  std::vector<Eigen::MatrixXd> j3;
+  one.evaluate(w.segment(3 * s, s), f3, &j3);
+  EXPECT_EQ(f3, f1.segment(3 * s, s));
+  EXPECT_EQ(j3[0], j1[3]);
+}
+
+}  // namespace

@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""frf.png: nonlinear forced response against the free linear response; loops.png:
+hysteresis loops of the contact pairs at the peak (from loops.csv)."""
+import csv
+import os
+
+
+def _read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return rows
+
+
+def plot_frf(result_dir):
+    import matplotlib.pyplot as plt
+
+    rows = _read_csv(os.path.join(result_dir, "frf.csv"))
+    if not rows:
+        return
+    f = [float(r["frequency_hz"]) for r in rows]
+    a = [float(r["amplitude_m"]) for r in rows]
+    lin = [float(r["linear_amplitude_m"]) for r in rows]
+    fig, ax = plt.subplots(figsize=(8, 5))
+    ax.semilogy(f, lin, color="0.6", lw=1, label="linear, contact open")
+    ax.semilogy(f, a, color="C0", lw=1.5, label="nonlinear (friction contact)")
+    harmonics = [k for k in rows[0] if k.startswith("h") and k.endswith("_m")]
+    for k in harmonics[2:]:  # h0 is the static part, h1 dominates; show the higher ones
+        ax.semilogy(f, [max(float(r[k]), 1e-30) for r in rows], lw=0.7, ls="--", label=k[:-2])
+    i = max(range(len(a)), key=lambda j: a[j])
+    ax.plot([f[i]], [a[i]], "o", color="C3", label=f"peak {a[i]:.3g} m at {f[i]:.2f} Hz")
+    ax.set_xlabel("excitation frequency [Hz]")
+    ax.set_ylabel("response amplitude max_t |u(t)| [m]")
+    ax.set_ylim(bottom=max(min(a) * 1e-3, 1e-14))
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(os.path.basename(os.path.normpath(result_dir)))
+    fig.tight_layout()
+    fig.savefig(os.path.join(result_dir, "frf.png"), dpi=110)
+    plt.close(fig)
+
+    loops = os.path.join(result_dir, "loops.csv")
+    if os.path.exists(loops):
+        plot_loops(result_dir)
+
+
+def plot_loops(result_dir):
+    import matplotlib.pyplot as plt
+
+    rows = _read_csv(os.path.join(result_dir, "loops.csv"))
+    pairs = sorted({int(r["pair"]) for r in rows})
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    for p in pairs:
+        sel = [r for r in rows if int(r["pair"]) == p]
+        sel.append(sel[0])  # close the loop
+        for ax, (x, y) in zip(axes, [("x_m", "tx_n"), ("y_m", "ty_n"), ("z_m", "n_n")]):
+            ax.plot([float(r[x]) for r in sel], [float(r[y]) for r in sel], lw=1, label=f"pair {p}")
+    for ax, t in zip(axes, ["tangential x", "tangential y", "normal"]):
+        ax.set_title(t)
+        ax.set_xlabel("relative displacement [m]")
+        ax.grid(True, alpha=0.3)
+    axes[0].set_ylabel("contact force [N]")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("contact loops at the peak")
+    fig.tight_layout()
+    fig.savefig(os.path.join(result_dir, "loops.png"), dpi=110)
+    plt.close(fig)

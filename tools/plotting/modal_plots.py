@@ -1,0 +1,116 @@
+#!/usr/bin/python3
+"""Plots of the modal results of a shroudsim result folder (matplotlib).
+
+plot_nd_map(result_dir):   modes.csv                     -> nd_map.png
+plot_campbell(result_dir): campbell.csv, crossings.csv   -> campbell.png
+
+nd_map.png: natural frequency against nodal diameter, one line per mode family (the r-th
+mode of every nodal diameter), left all families, right the lowest ten.
+campbell.png: frequency against speed, one horizontal line per mode (colour = nodal
+diameter), engine-order lines f = EO * rpm / 60, and the crossings where an engine order
+meets a mode of the nodal diameter it excites.
+"""
+import csv
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def _read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _families(rows):
+    """{nodal_diameter: [f_1, f_2, ...]} from modes.csv rows (one harmonic index per ND)."""
+    by_nd = {}
+    seen_h = {}
+    for r in rows:
+        nd, h = int(r["nodal_diameter"]), int(r["harmonic_index"])
+        if seen_h.setdefault(nd, h) != h:
+            continue  # h and Nb - h have equal frequencies: keep one
+        by_nd.setdefault(nd, []).append((int(r["mode"]), float(r["frequency_hz"])))
+    return {nd: [f for _, f in sorted(v)] for nd, v in sorted(by_nd.items())}
+
+
+def plot_nd_map(result_dir):
+    fam = _families(_read_csv(os.path.join(result_dir, "modes.csv")))
+    nds = sorted(fam)
+    n_modes = max(len(v) for v in fam.values())
+    fig, axes = plt.subplots(1, 2, figsize=(13, 6))
+    for ax, count in zip(axes, (n_modes, min(10, n_modes))):
+        for r in range(count):
+            xs = [nd for nd in nds if r < len(fam[nd])]
+            ys = [fam[nd][r] for nd in xs]
+            ax.plot(xs, ys, "o-", ms=3, lw=1, label=f"family {r + 1}" if count <= 10 else None)
+        ax.set_xlabel("nodal diameter")
+        ax.set_ylabel("frequency [Hz]")
+        ax.set_xticks(nds)
+        ax.grid(True, alpha=0.3)
+        ax.set_title("all %d mode families" % count if count == n_modes else "lowest %d mode families" % count)
+        if count <= 10:
+            ax.legend(fontsize=7, ncol=2)
+    fig.suptitle("Nodal diameter map")
+    fig.tight_layout()
+    fig.savefig(os.path.join(result_dir, "nd_map.png"), dpi=120)
+    plt.close(fig)
+
+
+def plot_campbell(result_dir):
+    rows = _read_csv(os.path.join(result_dir, "campbell.csv"))
+    crossings_path = os.path.join(result_dir, "crossings.csv")
+    crossings = _read_csv(crossings_path) if os.path.exists(crossings_path) else []
+    speeds = sorted({float(r["speed_rpm"]) for r in rows})
+    s0, s1 = speeds[0], speeds[-1]
+    lines = {}
+    seen_h = {}
+    for r in rows:
+        nd, h = int(r["nodal_diameter"]), int(r["harmonic_index"])
+        if seen_h.setdefault(nd, h) != h:
+            continue
+        lines.setdefault((nd, int(r["mode"])), []).append((float(r["speed_rpm"]), float(r["frequency_hz"])))
+    eos = sorted({int(c["engine_order"]) for c in crossings})
+    eo_max = max(eos) if eos else 1
+    f_top = 1.15 * eo_max * s1 / 60.0
+    if not eos:
+        f_top = max(max(f for _, f in v) for v in lines.values())
+    nds = sorted({nd for nd, _ in lines})
+    cmap = plt.get_cmap("viridis", max(len(nds), 2))
+    fig, ax = plt.subplots(figsize=(11, 7))
+    for (nd, _), pts in sorted(lines.items()):
+        pts.sort()
+        if min(f for _, f in pts) > f_top:
+            continue
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], color=cmap(nds.index(nd)), lw=1)
+    for nd in nds:
+        ax.plot([], [], color=cmap(nds.index(nd)), lw=2, label=f"ND {nd}")
+    for e in eos:
+        ax.plot([s0, s1], [e * s0 / 60.0, e * s1 / 60.0], "k--", lw=0.8)
+        ax.annotate(f"EO {e}", (s1, e * s1 / 60.0), fontsize=8, xytext=(3, 0), textcoords="offset points",
+                    va="center")
+    if crossings:
+        ax.plot([float(c["speed_rpm"]) for c in crossings], [float(c["frequency_hz"]) for c in crossings],
+                "ro", mfc="none", ms=7, label="crossing (EO excites ND)")
+    ax.set_xlim(s0, s1 * 1.06)
+    ax.set_ylim(0, f_top)
+    ax.set_xlabel("speed [rpm]")
+    ax.set_ylabel("frequency [Hz]")
+    ax.set_title("Campbell diagram (frequencies independent of speed)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(os.path.join(result_dir, "campbell.png"), dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    import sys
+
+    for d in sys.argv[1:]:
+        if os.path.exists(os.path.join(d, "modes.csv")):
+            plot_nd_map(d)
+        if os.path.exists(os.path.join(d, "campbell.csv")):
+            plot_campbell(d)
