@@ -1,0 +1,202 @@
+// The sector's modal receptances (with residual flexibility) against a direct solve of
+// the cyclic system (K_h - W^2 M_h)^-1 at the contact, response and excitation DOFs.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/SparseLU>
+#include <filesystem>
+#include <numbers>
+
+#include "cyclic/cyclic_sector.hpp"
+#include "fe/assembly.hpp"
+#include "frf/sector.hpp"
+#include "mesh/msh_reader.hpp"
+#include "mesh/sector_generator.hpp"
+#include "modal/harmonic.hpp"
+
+namespace shroudsim::frf {
+namespace {
+
+using Complex = std::complex<double>;
+
+struct Fixture {
+  mesh::Mesh mesh;
+  linalg::SparsePair<double> km;
+  std::unique_ptr<cyclic::CyclicSector> sector;
+
+  Fixture() {
+    mesh::SectorGeometry g;
+    g.element_order = 1;
+    g.mesh_size = 0.03;
+    const auto file = std::filesystem::temp_directory_path() / ("shroudsim_rec_" + std::to_string(::getpid()) + ".msh");
+    mesh::generate_sector_mesh(g, file, false);
+    mesh = mesh::read_sector_mesh(file, {g.sectors, 1e-9});
+    std::filesystem::remove(file);
+    km = fe::assemble(mesh, fe::Material{});
+    sector = std::make_unique<cyclic::CyclicSector>(mesh, km);
+  }
+};
+
+/// Direct Q = C R C^H with R = T_h (K_h - W^2 M_h)^-1 T_h^H (no damping), via the same C rows
+/// the sector part uses: contact pairs, response node, excitation force.
+Eigen::MatrixXcd direct(const Fixture& f, const std::vector<SectorContactPair>& pairs, const SectorForcing& forcing,
+                        int h, double w) {
+  const auto kmh = f.sector->reduce(h);
+  Eigen::SparseMatrix<Complex> a = kmh.K - w * w * kmh.M;
+  a.makeCompressed();
+  Eigen::SparseLU<Eigen::SparseMatrix<Complex>> lu(a);
+  const double alpha = 2 * std::numbers::pi / f.sector->sectors();
+  const Eigen::Matrix3d rot = cyclic::rotation_z(alpha);
+  const Complex phase = std::exp(Complex(0, h * alpha));
+  const int c = 3 * static_cast<int>(pairs.size());
+  Eigen::MatrixXcd rows = Eigen::MatrixXcd::Zero(c + 4, f.sector->n_full());
+  for (std::size_t i = 0; i < pairs.size(); ++i)
+    for (int a3 = 0; a3 < 3; ++a3)
+      for (int b = 0; b < 3; ++b) {
+        rows(3 * i + a3, 3 * pairs[i].high_node + b) += pairs[i].frame(a3, b);
+        rows(3 * i + a3, 3 * pairs[i].low_node + b) -= phase * (pairs[i].frame * rot)(a3, b);
+      }
+  for (int a3 = 0; a3 < 3; ++a3) rows(c + a3, 3 * forcing.response_node + a3) = 1.0;
+  for (int a3 = 0; a3 < 3; ++a3) rows(c + 3, 3 * forcing.excitation_node + a3) = forcing.force[a3];
+  const Eigen::MatrixXcd ct = rows * Eigen::MatrixXcd(f.sector->expansion(h));
+  const Eigen::MatrixXcd y = lu.solve(Eigen::MatrixXcd(ct.adjoint()));
+  return ct * y;
+}
+
+TEST(SectorReceptance, ModalSumWithResidualFlexibilityMatchesTheDirectSolve) {
+  const Fixture f;
+  // Three shroud pairs with a turned frame, response and excitation on the blade.
+  std::vector<SectorContactPair> pairs;
+  for (std::size_t i = 0; i < 3; ++i) {
+    SectorContactPair p;
+    p.low_node = f.mesh.shroud_pairs[i * 2].first;
+    p.high_node = f.mesh.shroud_pairs[i * 2].second;
+    p.frame = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    pairs.push_back(p);
+  }
+  SectorForcing forcing;
+  forcing.engine_order = 3;  // harmonic 1 -> h = 3, harmonic 2 -> h = 6 (= conj of 2)
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  forcing.damping_ratio = 0.0;
+
+  modal::ModalOptions mo;
+  mo.modes = 20;
+  std::map<int, modal::ModalBasis> bases;
+  std::map<int, modal::StiffnessFactor> factors;
+  for (int h : {0, 3, 6}) {
+    auto r = modal::solve_harmonic(*f.sector, h, mo);
+    ASSERT_TRUE(r.report.ok()) << r.report.message;
+    bases[h] = r.basis;
+    factors[h] = r.stiffness.valid() ? r.stiffness : modal::factor_harmonic_stiffness(*f.sector, h);
+  }
+  auto factor = [&](int h) { return factors.at(h); };
+  for (bool residual : {true, false}) {
+    forcing.residual_flexibility = residual;
+    const SectorLinearPart part(*f.sector, bases, factor, pairs, forcing, /*n_harmonics=*/2);
+    for (int n : {1, 2}) {
+      const int h = part.harmonic_index(n);
+      // Below the first mode of h: truncation error of the modal sum ~ (W / w_21)^2 with
+      // residual flexibility, ~ the static share of the truncated modes without it.
+      const double w = 0.5 * bases.at(h).omega[0] / n;
+      HarmonicReceptance rec;
+      part.harmonic(n, w, rec);
+      const Eigen::MatrixXcd q = direct(f, pairs, forcing, h, n * w);
+      const int c = part.n_contact();
+      const double err_g = (rec.G - q.topLeftCorner(c, c)).norm() / q.topLeftCorner(c, c).norm();
+      const double err_h = (rec.H - q.block(c, 0, 3, c)).norm() / q.block(c, 0, 3, c).norm();
+      // The excitation acts in temporal harmonic 1 only: u_lin of other harmonics is zero.
+      const double err_u = n == 1 ? (rec.u_lin - q.block(c, c + 3, 3, 1)).norm() / q.block(c, c + 3, 3, 1).norm()
+                                  : rec.u_lin.norm();
+      if (residual) {
+        constexpr double kTruncation = 1e-3;  // (0.5 w_1 / w_21)^2 is far below this here
+        EXPECT_LT(err_g, kTruncation) << "n " << n;
+        EXPECT_LT(err_h, kTruncation) << "n " << n;
+        EXPECT_LT(err_u, kTruncation) << "n " << n;
+      } else {
+        EXPECT_GT(err_g, 1e-3) << "without residual flexibility the local contact flexibility is missed";
+      }
+    }
+    // The static harmonic is exact: T_0 K_0^-1 T_0^T.
+    HarmonicReceptance r0;
+    part.harmonic(0, 1.0, r0);
+    const Eigen::MatrixXcd q0 = direct(f, pairs, forcing, 0, 0.0);
+    EXPECT_LT((r0.G - q0.topLeftCorner(9, 9)).norm(), 1e-10 * q0.topLeftCorner(9, 9).norm());
+  }
+}
+
+}  // namespace
+}  // namespace shroudsim::frf
+
+#include "forced/reduced_equations.hpp"
+
+namespace shroudsim::frf {
+namespace {
+
+TEST(SectorForced, EnergyBalanceAndOpenGapOnTheSector) {
+  const Fixture f;
+  std::vector<SectorContactPair> pairs;
+  std::vector<contact::PairParameters> params;
+  for (std::size_t i = 0; i < 3; ++i) {
+    SectorContactPair p;
+    p.low_node = f.mesh.shroud_pairs[i * 3].first;
+    p.high_node = f.mesh.shroud_pairs[i * 3].second;
+    pairs.push_back(p);
+    contact::PairParameters pp;
+    pp.tangential_stiffness = 2e5;
+    pp.normal_stiffness = 2e5;
+    pp.normal_preload = 0.02;
+    params.push_back(pp);
+  }
+  SectorForcing forcing;
+  forcing.engine_order = 1;
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, 1.0, 1.0);
+  forcing.damping_ratio = 0.01;
+  modal::ModalOptions mo;
+  mo.modes = 15;
+  std::map<int, modal::ModalBasis> bases;
+  for (int h : {1, 2, 3}) bases[h] = modal::solve_harmonic(*f.sector, h, mo).basis;
+  const SectorLinearPart part(*f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); },
+                              pairs, forcing, 3);
+  const double f_hz = 0.8 * bases.at(1).omega[0] / (2 * std::numbers::pi);
+  for (const char* model : {"1d", "quasi3d"}) {
+    hbm::ContactEvaluatorOptions o;
+    o.n_harmonics = 3;
+    o.n_time_samples = 64;
+    o.law.model = *contact::parse_model(model);
+    o.threads = 1;
+    hbm::ContactEvaluator ev(o, params);
+    forced::ReducedEquations eq(part, ev);
+    continuation::ArclengthOptions ao;
+    ao.x_scale = Eigen::VectorXd::Constant(eq.size(), 1e-6);
+    ao.tolerance = 1e-9;
+    Eigen::VectorXd w;
+    const auto b = eq.solve_by_excitation_homotopy(f_hz, ao, w);
+    ASSERT_EQ(b.status, continuation::BranchStatus::kReachedEnd) << model << ": " << b.message;
+    const forced::PointResult r = eq.analyse(w, f_hz);
+    // Excitation work = modal viscous + contact dissipation, to the Newton tolerance.
+    EXPECT_LT(r.energy_error, 1e-5) << model;
+    EXPECT_GT(r.contact_dissipation, 0.0) << model;
+  }
+  // A gap that never closes: the free response.
+  for (auto& p : params) p.normal_preload = -1e3;  // gap of 5 mm
+  hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = 3;
+  o.n_time_samples = 64;
+  o.threads = 1;
+  hbm::ContactEvaluator ev(o, params);
+  forced::ReducedEquations eq(part, ev);
+  continuation::ArclengthOptions ao;
+  ao.x_scale = Eigen::VectorXd::Constant(eq.size(), 1e-6);
+  Eigen::VectorXd w = eq.linear_motion(f_hz);
+  ASSERT_GE(continuation::newton_fixed(eq, w, f_hz, ao), 0);
+  const forced::PointResult r = eq.analyse(w, f_hz);
+  EXPECT_NEAR(r.amplitude / r.linear_amplitude, 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace shroudsim::frf
