@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "app/context.hpp"
+#include "app/modal_stage.hpp"
 #include "contact/contact_law.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -236,6 +237,7 @@ int cmd_contact(Context& ctx) {
             ", N = " + std::to_string(n) + ", " + std::to_string(detail.status.periods) + " periods" +
             (detail.status.converged ? "" : " (not converged)") + ", dissipated " + sci(energy) +
             " J/cycle -> " + (ctx.out_dir / "contact.json").string());
+  draw_plots(ctx);
   return 0;
 }
 

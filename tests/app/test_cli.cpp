@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "cli_runner.hpp"
@@ -209,6 +210,47 @@ TEST(Cli, StudyRunsEveryPointInItsOwnFolder) {
   // A higher preload sticks more: the 2 N point's peak is lower than the 0.5 N one.
   auto peak = [&](const std::string& line) { return std::stod(line.substr(line.find(",ok,") + 4)); };
   EXPECT_LT(peak(lines[2]), peak(lines[1]));
+}
+
+}  // namespace
+}  // namespace shroudsim::testing
+
+namespace shroudsim::testing {
+namespace {
+
+TEST(Cli, ContactCommandWritesTheCircularOrbitSolution) {
+  // A circular tangential orbit of radius 1e-6 m beyond the slip radius mu N / kt, at a
+  // constant normal load N = N0 + kn z0 = 1.1 N: |T| = mu N throughout (PHYSICS.md section 6),
+  // so the first harmonic of Tx has amplitude 0.33 N and the others vanish.
+  const Scratch s("contact");
+  s.write("c.toml", "name = \"c\"\n[contact]\nmodel = \"full3d\"\nfriction_coefficient = 0.3\nnormal_preload = 1.0\n"
+                    "[hbm]\nharmonics = 3\ntime_samples = 256\n[motion]\nx = [[1, 1e-6, 0.0]]\ny = [[1, 0.0, 1e-6]]\n"
+                    "z = [[0, 1e-7, 0.0]]\n");
+  const CliResult r = s.run("contact c.toml --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string j = slurp(s.dir() / "results" / "c" / "contact.json");
+  for (const char* key : {"\"force_harmonics\"", "\"time\"", "\"jacobian\"", "\"seconds\"", "\"tx\""})
+    EXPECT_NE(j.find(key), std::string::npos) << key;
+  // Parse the x force harmonics: [[0, c, s], [1, c, s], ...].
+  const auto at = j.find("\"x\"", j.find("\"force_harmonics\""));
+  ASSERT_NE(at, std::string::npos);
+  std::vector<double> v;
+  std::string num;
+  for (std::size_t i = j.find('[', at) + 1; v.size() < 12 && i < j.size(); ++i) {
+    const char ch = j[i];
+    if (std::isdigit(static_cast<unsigned char>(ch)) || ch == '-' || ch == '.' || ch == 'e' || ch == '+') {
+      num += ch;
+    } else if (!num.empty()) {
+      v.push_back(std::stod(num));
+      num.clear();
+    }
+  }
+  ASSERT_EQ(v.size(), 12u);
+  EXPECT_NEAR(std::hypot(v[4], v[5]), 0.33, 1e-9);  // harmonic 1 (exact_linear, constant N)
+  EXPECT_LT(std::hypot(v[7], v[8]) + std::hypot(v[10], v[11]), 1e-12);  // harmonics 2 and 3
+  const CliResult bad = s.run("contact c.toml --set 'motion.x=[[1, 1e-6]]'");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("motion.x"), std::string::npos) << bad.err;
 }
 
 }  // namespace
