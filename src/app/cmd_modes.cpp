@@ -110,7 +110,7 @@ std::vector<int> modal_harmonic_indices(const io::Case& c) {
   return hs;
 }
 
-ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices) {
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors) {
   const io::Case& c = ctx.config;
   ModalModel model;
   model.mesh = obtain_mesh(ctx);
@@ -196,6 +196,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
           o.result.report.message = e.what();
         }
         o.seconds = watch.seconds();
+        if (!keep_factors) o.result.stiffness = modal::StiffnessFactor();  // free the factor now
         const auto& r = o.result.report;
         std::string line = "modes h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
         if (r.ok()) {
@@ -248,7 +249,8 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
         ctx.report.warn(std::string("could not cache modes: ") + e.what());
       }
     }
-    if (o.result.stiffness.valid()) model.factors[h] = o.result.stiffness;
+    if (keep_factors && o.result.stiffness.valid()) model.factors[h] = o.result.stiffness;
+    o.result.stiffness = modal::StiffnessFactor();  // released here unless kept
   }
   report["harmonic_indices"] = harmonic_indices;
   report["solved"] = per_h;
@@ -364,6 +366,7 @@ void write_modes_vtu(Context& ctx, ModalModel& model) {
 }
 
 void draw_plots(Context& ctx) {
+  if (!ctx.plots) return;  // study points: the study plots once at the end
   const fs::path script = fs::path(SHROUDSIM_SOURCE_DIR) / "tools" / "plot.py";
   const char* python = "/usr/bin/python3";
   if (!fs::exists(python) || !fs::exists(script) ||
@@ -383,7 +386,7 @@ int cmd_modes(Context& ctx) {
   if (c.structure.type != "sector")
     throw InputError(location(c, "structure.type") + ": structure.type = \"" + c.structure.type +
                      "\": `modes` needs an FE sector (structure.type = \"sector\")");
-  ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c));
+  ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), /*keep_factors=*/false);
   write_modes_csv(ctx, model);
   if (!model.bases.empty()) write_modes_vtu(ctx, model);
   if (!model.failures.empty()) {

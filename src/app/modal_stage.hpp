@@ -51,8 +51,10 @@ std::vector<int> modal_harmonic_indices(const io::Case& c);
 
 /// Mesh (obtain_mesh), K and M, and the modes of `harmonic_indices` (cached where possible).
 /// A harmonic index whose solve fails is listed in ModalModel::failures (the caller writes
-/// what converged and throws NumericalError).
-ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices);
+/// what converged and throws NumericalError). keep_factors: keep the K_h factorizations of
+/// the solves in ModalModel::factors (memory: about nnz(L) * 16 bytes each; a harmonic index
+/// read from the cache gets its factor on demand from stiffness_factor()).
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors = true);
 
 /// modes.csv: harmonic_index,nodal_diameter,mode,frequency_hz (mode numbered from 1).
 void write_modes_csv(Context& ctx, const ModalModel& model);

@@ -2,6 +2,9 @@
 
 #include <Eigen/CholmodSupport>
 
+#include <algorithm>
+#include <stdexcept>
+
 #include "core/error.hpp"
 
 namespace shroudsim::linalg {
@@ -15,9 +18,37 @@ std::string to_string(FactorStatus status) {
   return "unknown";
 }
 
+namespace {
+// Eigen's wrapper plus access to the CHOLMOD factor for the half solves.
+template <typename Scalar>
+struct Decomposition : Eigen::CholmodDecomposition<SparseMatrix<Scalar>, Eigen::Lower> {
+  cholmod_factor* factor() const { return this->m_cholmodFactor; }
+};
+}  // namespace
+
 template <typename Scalar>
 struct CholmodFactor<Scalar>::Impl {
-  Eigen::CholmodDecomposition<SparseMatrix<Scalar>, Eigen::Lower> llt;
+  Decomposition<Scalar> llt;
+  // x = sys2(sys1(b)) with CHOLMOD's partial solves (int API, as Eigen uses for int indices).
+  void two_step(int sys1, int sys2, const Scalar* b, Scalar* x, Eigen::Index n) {
+    cholmod_common& c = llt.cholmod();
+    cholmod_dense B;
+    B.nrow = B.nzmax = B.d = static_cast<std::size_t>(n);
+    B.ncol = 1;
+    B.x = const_cast<Scalar*>(b);
+    B.z = nullptr;
+    B.xtype = std::is_same_v<Scalar, double> ? CHOLMOD_REAL : CHOLMOD_COMPLEX;
+    B.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* t = cholmod_solve(sys1, llt.factor(), &B, &c);
+    cholmod_dense* u = t ? cholmod_solve(sys2, llt.factor(), t, &c) : nullptr;
+    if (!u) {
+      if (t) cholmod_free_dense(&t, &c);
+      throw std::runtime_error("CHOLMOD partial solve failed");
+    }
+    std::copy_n(static_cast<const Scalar*>(u->x), n, x);
+    cholmod_free_dense(&t, &c);
+    cholmod_free_dense(&u, &c);
+  }
 };
 
 template <typename Scalar>
@@ -80,6 +111,20 @@ void CholmodFactor<Scalar>::solve(const Scalar* b, Scalar* x) const {
   Eigen::Map<const Vector> bm(b, rows_);
   Eigen::Map<Vector> xm(x, rows_);
   xm = impl_->llt.solve(Vector(bm));
+}
+
+template <typename Scalar>
+void CholmodFactor<Scalar>::solve_forward(const Scalar* b, Scalar* x) const {
+  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_forward without a valid factor");
+  SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
+  impl_->two_step(CHOLMOD_P, CHOLMOD_L, b, x, rows_);
+}
+
+template <typename Scalar>
+void CholmodFactor<Scalar>::solve_backward(const Scalar* b, Scalar* x) const {
+  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_backward without a valid factor");
+  SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
+  impl_->two_step(CHOLMOD_Lt, CHOLMOD_Pt, b, x, rows_);
 }
 
 template <typename Scalar>

@@ -53,6 +53,11 @@ class CholmodFactor {
   Matrix solve(const Matrix& b) const;
   /// x = A^{-1} b on raw arrays of length rows().
   void solve(const Scalar* b, Scalar* x) const;
+  /// Half solves with the factor P A P^T = L L^H (P the fill-reducing permutation):
+  /// forward x = L^{-1} P b, backward x = P^T L^{-H} b; backward(forward(b)) = A^{-1} b.
+  /// Used for the symmetric form L^{-1} P M P^T L^{-H} of a generalized eigenproblem.
+  void solve_forward(const Scalar* b, Scalar* x) const;
+  void solve_backward(const Scalar* b, Scalar* x) const;
 
   FactorStatus status() const { return status_; }
   Eigen::Index rows() const { return rows_; }

@@ -1,7 +1,7 @@
 #include "modal/eigensolver.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <Spectra/SymGEigsShiftSolver.h>
+#include <Spectra/SymEigsSolver.h>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -104,102 +104,43 @@ namespace {
 template <typename S>
 constexpr bool kIsComplex = !std::is_same_v<S, double>;
 
-/// y = (K - sigma M)^{-1} x; set_shift factorizes (symbolic analysis once).
+/// The symmetric shift-invert operator y = L^{-1} P M P^T L^{-H} x, with P (K - sigma M) P^T
+/// = L L^H, on the real representation (n for real, [Re; Im] of length 2n for complex).
+/// Its eigenvalues are nu = 1 / (lambda - sigma) and its eigenvectors y = L^H P x, so Lanczos
+/// runs in the Euclidean inner product: one solve and one product with M per step (the
+/// B-inner-product form of SymGEigsShiftSolver applies M about eight times per step).
 template <typename S>
-class ShiftInvertOp {
+class SymmetricShiftInvertOp {
  public:
   using Scalar = double;
-  ShiftInvertOp(const linalg::SparsePair<S>& km, linalg::FactorMethod method)
-      : km_(km), n_(km.K.rows()), factor_(std::make_shared<linalg::CholmodFactor<S>>(method)), z_(n_), w_(n_) {}
-  Eigen::Index rows() const { return kIsComplex<S> ? 2 * n_ : n_; }
-  Eigen::Index cols() const { return rows(); }
-  void set_shift(double sigma) {
-    log::Stopwatch watch;
-    linalg::SparseMatrix<S> A = sigma == 0.0 ? linalg::SparseMatrix<S>(km_.K)
-                                             : linalg::SparseMatrix<S>(km_.K - S(sigma) * km_.M);
-    A.makeCompressed();
-    status_ = factor_->compute(A);
-    sigma_ = sigma;
-    seconds_ = watch.seconds();
-  }
-  void perform_op(const double* x, double* y) const {
-    if constexpr (kIsComplex<S>) {
-      for (Eigen::Index i = 0; i < n_; ++i) z_[i] = S(x[i], x[n_ + i]);
-      factor_->solve(z_.data(), w_.data());
-      for (Eigen::Index i = 0; i < n_; ++i) {
-        y[i] = w_[i].real();
-        y[n_ + i] = w_[i].imag();
-      }
-    } else {
-      factor_->solve(x, y);
-    }
-  }
-  linalg::FactorStatus status() const { return status_; }
-  double sigma() const { return sigma_; }
-  double seconds() const { return seconds_; }
-  const std::shared_ptr<linalg::CholmodFactor<S>>& factor() const { return factor_; }
-
- private:
-  const linalg::SparsePair<S>& km_;
-  Eigen::Index n_;
-  std::shared_ptr<linalg::CholmodFactor<S>> factor_;
-  linalg::FactorStatus status_ = linalg::FactorStatus::Failed;
-  double sigma_ = 0.0, seconds_ = 0.0;
-  mutable Eigen::Matrix<S, Eigen::Dynamic, 1> z_, w_;
-};
-
-/// y = M x on the real representation. For complex M = Mr + i Mi (Mi holds only the few
-/// couplings across the cyclic boundary), [a; b] -> [Mr a - Mi b; Mr b + Mi a] with one pass
-/// over the real Mr for both halves: Lanczos calls this several times per step.
-template <typename S>
-class MassOp {
- public:
-  using Scalar = double;
-  explicit MassOp(const linalg::SparseMatrix<S>& M) : n_(M.rows()) {
-    if constexpr (kIsComplex<S>) {
-      Mr_ = M.real();
-      Mi_ = M.imag();
-      Mi_.prune(0.0);
-      Mr_.makeCompressed();
-      Mi_.makeCompressed();
-    } else {
-      Mr_ = M;
-    }
-  }
+  SymmetricShiftInvertOp(const linalg::CholmodFactor<S>& factor, const linalg::SparseMatrix<S>& M)
+      : factor_(factor), M_(M), n_(M.rows()), a_(n_), b_(n_) {}
   Eigen::Index rows() const { return kIsComplex<S> ? 2 * n_ : n_; }
   Eigen::Index cols() const { return rows(); }
   void perform_op(const double* x, double* y) const {
     ++products_;
     if constexpr (kIsComplex<S>) {
-      const double* a = x;
-      const double* b = x + n_;
-      double* ya = y;
-      double* yb = y + n_;
-      std::fill(y, y + 2 * n_, 0.0);
-      const int* outer = Mr_.outerIndexPtr();
-      const int* inner = Mr_.innerIndexPtr();
-      const double* val = Mr_.valuePtr();
-      for (Eigen::Index j = 0; j < n_; ++j) {
-        const double aj = a[j], bj = b[j];
-        for (int k = outer[j]; k < outer[j + 1]; ++k) {
-          ya[inner[k]] += val[k] * aj;
-          yb[inner[k]] += val[k] * bj;
-        }
+      for (Eigen::Index i = 0; i < n_; ++i) a_[i] = S(x[i], x[n_ + i]);
+      factor_.solve_backward(a_.data(), b_.data());
+      a_.noalias() = M_ * b_;
+      factor_.solve_forward(a_.data(), b_.data());
+      for (Eigen::Index i = 0; i < n_; ++i) {
+        y[i] = b_[i].real();
+        y[n_ + i] = b_[i].imag();
       }
-      for (Eigen::Index j = 0; j < n_; ++j)
-        for (linalg::SparseMatrixD::InnerIterator it(Mi_, j); it; ++it) {
-          ya[it.row()] -= it.value() * b[j];
-          yb[it.row()] += it.value() * a[j];
-        }
     } else {
-      Eigen::Map<Eigen::VectorXd>(y, n_).noalias() = Mr_ * Eigen::Map<const Eigen::VectorXd>(x, n_);
+      factor_.solve_backward(x, b_.data());
+      a_.noalias() = M_ * b_;
+      factor_.solve_forward(a_.data(), y);
     }
   }
   long products() const { return products_; }
 
  private:
+  const linalg::CholmodFactor<S>& factor_;
+  const linalg::SparseMatrix<S>& M_;
   Eigen::Index n_;
-  linalg::SparseMatrixD Mr_, Mi_;
+  mutable Eigen::Matrix<S, Eigen::Dynamic, 1> a_, b_;
   mutable long products_ = 0;
 };
 
@@ -307,52 +248,82 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
   const Eigen::Index real_n = kIsComplex<S> ? 2 * n : n;
   ModalReport report;
   report.method = kIsComplex<S> ? "spectra-complex-2n" : "spectra-real";
-  ShiftInvertOp<S> op(km, options.factor_method);
-  MassOp<S> bop(km.M);
   const Eigen::Index nev = std::min<Eigen::Index>(kIsComplex<S> ? 2 * options.modes + 4 : options.modes, real_n - 1);
   Eigen::Index ncv = options.ncv > 0 ? options.ncv : std::max<Eigen::Index>(2 * nev + 1, nev + 20);
   ncv = std::min(std::max(ncv, nev + 1), real_n);
   report.requested_eigenvalues = static_cast<int>(nev);
 
-  using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOp<S>, MassOp<S>, Spectra::GEigsMode::ShiftInvert>;
-  Solver solver(op, bop, nev, ncv, options.shift);  // calls op.set_shift: the factorization
-  report.factor_seconds = op.seconds();
-  report.factor_nonzeros = op.factor()->factor_nonzeros();
-  if (op.status() != linalg::FactorStatus::Success) {
+  log::Stopwatch watch;
+  auto factor = std::make_shared<linalg::CholmodFactor<S>>(options.factor_method);
+  {
+    linalg::SparseMatrix<S> A = options.shift == 0.0 ? linalg::SparseMatrix<S>(km.K)
+                                                     : linalg::SparseMatrix<S>(km.K - S(options.shift) * km.M);
+    A.makeCompressed();
+    factor->compute(A);
+  }
+  report.factor_seconds = watch.seconds();
+  report.factor_nonzeros = factor->factor_nonzeros();
+  if (factor->status() != linalg::FactorStatus::Success) {
     report.status = ModalStatus::FactorizationFailed;
     report.message = "CHOLMOD factorization of K - sigma M (sigma = " + std::to_string(options.shift) +
-                     ") failed: " + linalg::to_string(op.status());
+                     ") failed: " + linalg::to_string(factor->status());
     ModalResult r;
     r.report = report;
     return r;
   }
-  log::Stopwatch watch;
+  SymmetricShiftInvertOp<S> op(*factor, km.M);
+  Spectra::SymEigsSolver<SymmetricShiftInvertOp<S>> solver(op, nev, ncv);
+  watch.restart();
   solver.init();
-  const Eigen::Index nconv = solver.compute(Spectra::SortRule::LargestMagn, options.max_restarts, options.tolerance);
-  report.solve_seconds = watch.seconds();
+  const Eigen::Index nconv = solver.compute(Spectra::SortRule::LargestAlge, options.max_restarts, options.tolerance);
   report.spectra_info = static_cast<int>(solver.info());
   report.converged_eigenvalues = static_cast<int>(nconv);
   report.iterations = static_cast<int>(solver.num_iterations());
   report.operations = static_cast<int>(solver.num_operations());
-  report.mass_products = static_cast<int>(bop.products());
+  report.mass_products = static_cast<int>(op.products());
   if (solver.info() != Spectra::CompInfo::Successful || nconv < nev) {
+    report.solve_seconds = watch.seconds();
     report.status = ModalStatus::NotConverged;
-    report.message = "Spectra SymGEigsShiftSolver: " + std::to_string(nconv) + " of " + std::to_string(nev) +
+    report.message = "Spectra SymEigsSolver (shift-invert): " + std::to_string(nconv) + " of " + std::to_string(nev) +
                      " eigenvalues converged after " + std::to_string(report.iterations) +
                      " restarts (CompInfo " + std::to_string(report.spectra_info) + ")";
     ModalResult r;
     r.report = report;
     return r;
   }
-  const Eigen::VectorXd ritz = solver.eigenvalues();
-  const Eigen::MatrixXd X = solver.eigenvectors();
+  // nu = 1 / (lambda - sigma) > 0 (K - sigma M positive definite); x = P^T L^{-H} y / sqrt(nu)
+  // is mass-normalised (x^H M x = nu y^H y).
+  const Eigen::VectorXd nu = solver.eigenvalues();
+  const Eigen::MatrixXd Y = solver.eigenvectors();
+  if (!(nu.minCoeff() > 0.0)) {
+    report.solve_seconds = watch.seconds();
+    report.status = ModalStatus::NotConverged;
+    report.message = "shift-invert operator returned a non-positive eigenvalue";
+    ModalResult r;
+    r.report = report;
+    return r;
+  }
+  const Eigen::VectorXd ritz = (1.0 / nu.array() + options.shift).matrix();
+  MatrixS<S> Xs(n, nu.size());
+  {
+    Eigen::Matrix<S, Eigen::Dynamic, 1> yc(n), xc(n);
+    for (Eigen::Index j = 0; j < nu.size(); ++j) {
+      if constexpr (kIsComplex<S>)
+        yc = Y.col(j).head(n).template cast<S>() + S(0, 1) * Y.col(j).tail(n).template cast<S>();
+      else
+        yc = Y.col(j);
+      factor->solve_backward(yc.data(), xc.data());
+      Xs.col(j) = xc / std::sqrt(nu(j));
+    }
+  }
+  report.solve_seconds = watch.seconds();
 
   ModalResult result;
   if constexpr (!kIsComplex<S>) {
-    result = finish<S>(km, h, ritz, X, options, report);
+    result = finish<S>(km, h, ritz, Xs, options, report);
   } else {
     // Back to complex vectors; each physical mode may appear up to twice (z and i z).
-    const Eigen::MatrixXcd Z = X.topRows(n).template cast<Complex>() + Complex(0, 1) * X.bottomRows(n).template cast<Complex>();
+    const Eigen::MatrixXcd& Z = Xs;
     std::vector<Eigen::Index> order(ritz.size());
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](auto a, auto b) { return ritz(a) < ritz(b); });
@@ -366,7 +337,7 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
         ++g1;
       const auto size = static_cast<Eigen::Index>(g1 - g0);
       if (size == 1) {
-        // x^T M_2n x = 1 gives z^H M z = 1: already mass-normalised.
+        // Already mass-normalised (z^H M z = 1).
         lam.push_back(ritz(order[g0]));
         vecs.push_back(Z.col(order[g0]));
       } else {
@@ -402,9 +373,9 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
   }
   if (result.report.ok() && options.shift == 0.0) {
     if constexpr (kIsComplex<S>)
-      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(op.factor()), false);
+      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(factor), false);
     else
-      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>>(op.factor()));
+      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>>(factor));
   }
   return result;
 }

@@ -1,17 +1,21 @@
 #pragma once
 // Lowest modes of K phi = w^2 M phi (real symmetric, or complex Hermitian from the cyclic
-// reduction), by Spectra's shift-invert Lanczos (SymGEigsShiftSolver) on a CHOLMOD
-// factorization of K - sigma M.
+// reduction) by Spectra's Lanczos (SymEigsSolver, implicit restarts) on the symmetric
+// shift-invert operator  L^{-1} P M P^T L^{-H},  P (K - sigma M) P^T = L L^H  (CHOLMOD,
+// supernodal). Its eigenvalues are nu = 1 / (w^2 - sigma), its eigenvectors y = L^H P phi;
+// Lanczos then needs the Euclidean inner product only: one solve and one product with M
+// per step (Spectra 1.0.1's SymGEigsShiftSolver, with M-inner products, applies M about
+// eight times per step).
 //
 // Complex Hermitian problems are solved through the real symmetric 2n embedding
-//   [Re K  -Im K] [a]       [Re M  -Im M] [a]
-//   [Im K   Re K] [b] = w^2 [Im M   Re M] [b],     z = a + i b,
-// whose operator applies one complex CHOLMOD solve of K - sigma M (cheaper than factoring
-// the 2n real matrix). Every physical mode z appears twice there ([a; b] and the
-// embedding of i z, [-b; a]); Spectra is asked for 2 * modes + 4 eigenvalues, the Ritz
-// vectors are mapped back to complex vectors, grouped by eigenvalue, and each group's
-// complex span is reduced to its physical modes (M-orthonormalised, Rayleigh-Ritz when a
-// group holds more than one physical mode). Each mode is returned once.
+//   H = A + i B  ->  [A  -B]        z = a + i b  ->  [a; b],
+//                    [B   A],
+// applied with complex CHOLMOD half solves (cheaper than factoring the 2n real matrix).
+// Every physical mode z appears twice there ([a; b] and the embedding of i z, [-b; a]);
+// Spectra is asked for 2 * modes + 4 eigenvalues, the Ritz vectors are mapped back to
+// complex vectors, grouped by eigenvalue, and each group's complex span is reduced to its
+// physical modes (M-orthonormalised, Rayleigh-Ritz when a group holds more than one
+// physical mode). Each mode is returned once.
 //
 // Every returned mode is checked: ||K phi - w^2 M phi|| <= residual_tolerance * ||K phi||.
 // Failure (factorization, Spectra not converging, residual too large, too few modes) is
@@ -72,7 +76,7 @@ struct ModalReport {
   int converged_eigenvalues = 0;  ///< nconv
   int iterations = 0;             ///< Spectra restarts
   int operations = 0;             ///< operator applications (solves)
-  int mass_products = 0;          ///< products with M (operator and M-inner products)
+  int mass_products = 0;          ///< products with M (one per operator application)
   double max_residual = 0.0;      ///< max relative residual of the returned modes
   double factor_nonzeros = 0.0;
   double factor_seconds = 0.0, solve_seconds = 0.0;
