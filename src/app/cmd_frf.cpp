@@ -59,6 +59,9 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
   o.law.update = *contact::parse_update(c.contact.tangential_update);
   o.jacobian = *hbm::parse_jacobian(c.hbm.jacobian);
   o.threads = threads;
+  // FFTW_MEASURE picks plans by timing, so round-off (and with it a Newton path through
+  // nonsmooth contact states) would change from run to run: estimated plans are reproducible.
+  o.measure_plans = false;
   if (o.law.model == contact::Model::one_d_exact && o.n_harmonics != 1)
     throw InputError(c.locations.at("hbm.harmonics") + ": hbm.harmonics = " + std::to_string(c.hbm.harmonics) +
                      " violates: harmonics = 1 for contact.model = \"1d_exact\" (the time-continuous single-harmonic law)");
@@ -112,7 +115,12 @@ int cmd_frf(Context& ctx) {
   // Start: Newton from the stuck-contact solution; where it fails (Newton cycling between
   // contact states), continuation in the excitation level from the preload-only state.
   Eigen::VectorXd start = equations.stuck_solution(ao.lambda_start);
-  if (continuation::newton_fixed(equations, start, ao.lambda_start, ao) < 0) {
+  bool started = continuation::newton_fixed(equations, start, ao.lambda_start, ao) >= 0;
+  if (!started) {  // second guess: the free response (contacts open or sliding freely)
+    start = equations.linear_motion(ao.lambda_start);
+    started = continuation::newton_fixed(equations, start, ao.lambda_start, ao) >= 0;
+  }
+  if (!started) {
     start = equations.stuck_solution(ao.lambda_start);
     const continuation::Branch h = equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start);
     ctx.report.section("frf")["start_homotopy_points"] = h.points.size();

@@ -1,5 +1,7 @@
 #include "contact/contact_law.hpp"
 
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -343,6 +345,30 @@ void LinearizedPeriod::expand(const Eigen::MatrixXd& basis, std::array<RowMatrix
     if (!pressed.empty() && pressed[l]) df[2].row(l).segment(2 * m, m) = kn * basis.row(l);
 }
 
+namespace {
+// Pseudo-inverse of A = I - Phi_d (2 x 2). Phi_d is a product of per-sample maps: 0 at
+// separation, a contraction at slip, the identity in stick, and exactly neutral directions
+// (eigenvalue 1: a family of periodic states, e.g. a static tangential load at the slip
+// limit, or pure stick) appear as singular values of A at the round-off of that product
+// (~1e-13 for a few hundred samples). Those directions are dropped (d* held along them, as
+// d = 0 is kept in pure stick); kSingular sits well above that round-off and far below any
+// contraction the iteration resolves (1 - lambda = 1e-10 would need ~1e11 plain periods).
+constexpr double kSingular = 1e-10;
+// Plain periods before the Newton iteration of the coupled model starts (see run()).
+constexpr int kPlainPeriods = 4;
+bool pseudo_inverse2(const Eigen::Matrix2d& a, Eigen::Matrix2d& inv) {
+  if (!a.allFinite()) return false;
+  const Eigen::JacobiSVD<Eigen::Matrix2d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector2d sv = svd.singularValues();
+  Eigen::Vector2d si = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 2; ++i)
+    if (sv(i) > kSingular) si(i) = 1.0 / sv(i);
+  if (si.isZero(0.0)) return false;
+  inv = svd.matrixV() * si.asDiagonal() * svd.matrixU().transpose();
+  return inv.allFinite();
+}
+}  // namespace
+
 template <bool kD>
 PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX3d& w,
                                 Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
@@ -352,11 +378,6 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
   const bool two_d = model != Model::one_d;
   const bool has_normal = model != Model::one_d;
   const bool coupled = model == Model::full3d;
-  const bool exact = options_.update == TangentialUpdate::exact_linear;
-  const double kt = pair.tangential_stiffness;
-  const double kn = pair.normal_stiffness;
-  const double mu = pair.friction_coefficient;
-  const double n0 = pair.normal_preload;
 
   const int m = kD ? static_cast<int>(basis->cols()) : 0;
   const int p = n_directions(model) * m;
@@ -369,12 +390,11 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
   const double tol = options_.period_tolerance * wmax;
 
   f.setZero(n, 3);
-  std::array<bool, 2> prev_stick{false, false};
   if constexpr (kD) {
     xd_.setZero(p);
     yd_.setZero(p);
-    lin->kt = kt;
-    lin->kn = has_normal ? kn : 0.0;
+    lin->kt = pair.tangential_stiffness;
+    lin->kn = has_normal ? pair.normal_stiffness : 0.0;
     lin->p = p;
     const int nd = two_d ? 2 : 1;
     for (int i = 0; i < 2; ++i) {
@@ -386,12 +406,169 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
     }
     lin->pressed.assign(n, 0);
   }
+  d_ = {0.0, 0.0};  // damper position [m], starts at 0
+  anchor_ = {};
+  PeriodicStatus status;
+  status.converged = false;
+  auto change = [](const std::array<double, 2>& a, const std::array<double, 2>& b) {
+    return std::max(std::abs(a[0] - b[0]), std::abs(a[1] - b[1]));
+  };
+
+  if (!coupled) {
+    // Uncoupled models: plain repetition (memoryless slip: 2 periods typically), the
+    // derivative carried through all periods by the anchors.
+    for (int k = 1; k <= options_.max_periods; ++k) {
+      const std::array<double, 2> d_start = d_;
+      period<kD>(pair, w, f, basis, lin, false);
+      status.periods = k;
+      if (change(d_, d_start) <= tol) {
+        status.converged = true;
+        break;
+      }
+    }
+    return status;
+  }
+
+  // Coupled model. First plain repetition from d = 0 for up to kPlainPeriods periods (with
+  // the derivative carried through them, as for the uncoupled models): most states repeat
+  // within 2 to 4 periods, at the cost they had before.
+  for (int k = 1; k <= std::min(kPlainPeriods, options_.max_periods); ++k) {
+    const std::array<double, 2> d_start = d_;
+    last_start_ = d_start;
+    period<kD>(pair, w, f, basis, lin, false);
+    status.periods = k;
+    if (change(d_, d_start) <= tol) {
+      status.converged = true;
+      return status;
+    }
+  }
+  // Slow repetition (a weak contraction, e.g. a static tangential load at the slip limit with
+  // a small oscillation: ~0.998 per period): safeguarded Newton on g(d) = Phi(d) - d from where
+  // the plain periods ended, forces-only periods carrying Phi_d. A Newton step is accepted
+  // when it reduces max|g| (Phi is strongly curved far from d*: the first steps reduce |g| by
+  // ~2, the last ones quadratically), else the plain repetition d <- Phi(d) is taken.
+  std::array<double, 2> dk{0.0, 0.0};  // accepted iterate
+  auto pass = [&](const std::array<double, 2>& start) {
+    d_ = start;
+    period<false>(pair, w, f, nullptr, nullptr, true);
+    ++status.periods;
+    return std::array<double, 2>{d_[0] - start[0], d_[1] - start[1]};  // g(start)
+  };
+  // From where the plain periods ended (unless the cap is reached already).
+  dk = d_;
+  std::array<double, 2> g{};
+  double gn = 0.0;
+  Eigen::Matrix2d jk = Eigen::Matrix2d::Identity();
+  bool slipped = false;
+  if (status.periods < options_.max_periods) {
+    g = pass(dk);
+    gn = std::max(std::abs(g[0]), std::abs(g[1]));
+    jk = dd_start_;
+    slipped = slipped_;
+  } else {
+    gn = change(d_, last_start_);
+    dk = last_start_;
+  }
+  while (!(gn <= tol) && status.periods < options_.max_periods) {
+    if (slipped) {
+      // Newton: g(dk + delta) ~ g + (Phi_d - I) delta = 0.
+      Eigen::Matrix2d ai;
+      if (pseudo_inverse2(Eigen::Matrix2d::Identity() - jk, ai)) {
+        const Eigen::Vector2d delta = ai * Eigen::Vector2d(g[0], g[1]);
+        const std::array<double, 2> trial{dk[0] + delta.x(), dk[1] + delta.y()};
+        if (std::isfinite(trial[0]) && std::isfinite(trial[1]) && (delta.x() != 0.0 || delta.y() != 0.0)) {
+          const std::array<double, 2> gt = pass(trial);
+          const double gtn = std::max(std::abs(gt[0]), std::abs(gt[1]));
+          if (gtn <= tol || gtn < gn) {  // accepted
+            dk = trial;
+            g = gt;
+            gn = gtn;
+            jk = dd_start_;
+            slipped = slipped_;
+            continue;
+          }
+          if (status.periods >= options_.max_periods) break;
+        }
+      }
+    }
+    // Safeguard: plain repetition, dk <- Phi(dk) = dk + g.
+    dk = {dk[0] + g[0], dk[1] + g[1]};
+    g = pass(dk);
+    gn = std::max(std::abs(g[0]), std::abs(g[1]));
+    jk = dd_start_;
+    slipped = slipped_;
+  }
+  status.converged = gn <= tol;
+  if constexpr (kD) {
+    // The returned period once more from dk with the derivative, at fixed d_start
+    // (xd_ = yd_ = 0), carrying the sensitivities to d_start; then add the term through
+    // dd*/dc = (I - Phi_d)^{-1} Phi_c.
+    d_ = dk;
+    xd_.setZero();
+    yd_.setZero();
+    period<true>(pair, w, f, basis, lin, true);
+    Eigen::Matrix2d ai;
+    fixed_point_dc_.resize(2, p);
+    if (slipped_ && pseudo_inverse2(Eigen::Matrix2d::Identity() - dd_start_, ai)) {
+      fixed_point_dc_.row(0) = ai(0, 0) * xd_ + ai(0, 1) * yd_;
+      fixed_point_dc_.row(1) = ai(1, 0) * xd_ + ai(1, 1) * yd_;
+    } else {
+      fixed_point_dc_.setZero();  // pure stick: d* held (see the header)
+    }
+    if (!fixed_point_dc_.isZero(0.0)) {
+      const auto z0 = fixed_point_dc_.row(0);
+      const auto z1 = fixed_point_dc_.row(1);
+      for (int i = 0; i < 2; ++i) {
+        for (size_t r = 0; r < lin->runs[i].size(); ++r) {
+          const Eigen::Matrix2d& s = run_d_[i][r];
+          lin->run_x[i].row(static_cast<Eigen::Index>(r)) += s(i, 0) * z0 + s(i, 1) * z1;
+        }
+        for (size_t k = 0; k < lin->dense_index[i].size(); ++k) {
+          const Eigen::Matrix2d& q = dense_q_[k];
+          lin->dense[i].row(static_cast<Eigen::Index>(k)) += q(i, 0) * z0 + q(i, 1) * z1;
+        }
+      }
+    }
+  }
+  return status;
+}
+
+template <bool kD>
+void PeriodicLaw::period(const PairParameters& pair, const Eigen::MatrixX3d& w,
+                         Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
+                         LinearizedPeriod* lin, bool track) {
+  const int n = static_cast<int>(w.rows());
+  const Model model = options_.model;
+  const bool two_d = model != Model::one_d;
+  const bool has_normal = model != Model::one_d;
+  const bool coupled = model == Model::full3d;
+  const bool exact = options_.update == TangentialUpdate::exact_linear;
+  const double kt = pair.tangential_stiffness;
+  const double kn = pair.normal_stiffness;
+  const double mu = pair.friction_coefficient;
+  const double n0 = pair.normal_preload;
+  const int m = kD ? static_cast<int>(basis->cols()) : 0;
+  std::array<double, 2>& d = d_;
+  std::array<Anchor, 2>& anchor = anchor_;
+  Eigen::Matrix2d& dd0 = dd_start_;  // d(d)/d(d_start)
+  if (track) {
+    dd0.setIdentity();
+    slipped_ = false;
+    if constexpr (kD) {
+      run_d_[0].clear();
+      run_d_[1].clear();
+      dense_q_.clear();
+    }
+  }
+
+  std::array<bool, 2> prev_stick{false, false};
   // Bookkeeping of the derivative of the current period (see LinearizedPeriod).
   auto rec_stick = [&](int i, int l) {
     if constexpr (kD) {
       if (!prev_stick[i]) {
         lin->runs[i].push_back({l, l, -1, 0.0, 0.0});
         lin->run_x[i].row(static_cast<Eigen::Index>(lin->runs[i].size() - 1)) = (i == 0) ? xd_ : yd_;
+        if (track) run_d_[i].push_back(dd0);
       } else {
         lin->runs[i].back().last = l;
       }
@@ -399,12 +576,6 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
     prev_stick[i] = true;
   };
   auto rec_none = [&](int i) { prev_stick[i] = false; };
-  // Uncoupled models: X_i = alpha E_i(s) + beta E_z(s).
-  struct Anchor {
-    int s = 0;
-    double alpha = 0.0, beta = 0.0;
-  };
-  std::array<Anchor, 2> anchor{};
   auto rec_anchor_stick = [&](int i, int l) {
     if constexpr (kD) {
       const Anchor& an = anchor[i];
@@ -422,221 +593,229 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
     prev_stick[i] = false;
   };
 
-  std::array<double, 2> d{0.0, 0.0};  // damper position [m], starts at 0
-  PeriodicStatus status;
-  status.converged = false;
-  for (int period = 1; period <= options_.max_periods; ++period) {
-    const std::array<double, 2> d_start = d;
-    prev_stick = {false, false};
-    if constexpr (kD) {
-      for (int i = 0; i < 2; ++i) {
-        lin->runs[i].clear();
-        lin->dense_index[i].clear();
-        lin->slip_weight[i].assign(coupled || i >= (two_d ? 2 : 1) ? 0 : n, 0.0);
-      }
-    }
-    for (int l = 0; l < n; ++l) {
-      const int lp = (l == 0) ? n - 1 : l - 1;
-      const double wx = w(l, 0);
-      const double wy = two_d ? w(l, 1) : 0.0;
-      double nl = has_normal ? n0 + kn * w(l, 2) : n0;
-      const bool pressed = nl > 0.0;
-      if (!pressed) nl = 0.0;
-      double nprev = has_normal ? n0 + kn * w(lp, 2) : n0;  // N(l-1), for exact_linear
-      const bool pressed_prev = nprev > 0.0;
-      if (!pressed_prev) nprev = 0.0;
-      const double lim = mu * nl;
-      double tx = 0.0, ty = 0.0;
-      auto e_row = [&](int row) { return basis->row(row); };
-      if constexpr (kD) lin->pressed[l] = (pressed && has_normal) ? 1 : 0;
-
-      if (!pressed || !(lim > 0.0)) {
-        // Separation (or no friction): no tangential force, the damper follows.
-        d = {wx, wy};
-        rec_none(0);
-        rec_none(1);
-        anchor[0] = {l, 1.0, 0.0};
-        anchor[1] = {l, 1.0, 0.0};
-        if constexpr (kD) {
-          xd_.setZero();
-          xd_.segment(0, m) = e_row(l);
-          if (two_d) {
-            yd_.setZero();
-            yd_.segment(m, m) = e_row(l);
-          }
-        }
-      } else if (coupled && !exact) {
-        // full3d, radial return.
-        const double tsx = kt * (wx - d[0]);
-        const double tsy = kt * (wy - d[1]);
-        const double nt = std::sqrt(tsx * tsx + tsy * tsy);
-        if (nt <= lim) {
-          tx = tsx;
-          ty = tsy;
-          rec_stick(0, l);  // dT = kt (dw_t - dd), dd unchanged
-          rec_stick(1, l);
-        } else {
-          const double ex = tsx / nt, ey = tsy / nt;
-          tx = lim * ex;
-          ty = lim * ey;
-          d = {wx - tx / kt, wy - ty / kt};
-          if constexpr (kD) {
-            // dT = mu dN dir + (mu N/|T*|)(I - dir dir^T) dT*,  dT* = kt (dw_t - dd),
-            // dd = dw_t - dT/kt; one fused pass over the P columns, written straight into
-            // the dense rows of this sample.
-            const double rho = lim / nt;
-            const Eigen::Index k = static_cast<Eigen::Index>(lin->dense_index[0].size());
-            double* rx = lin->dense[0].row(k).data();
-            double* ry = lin->dense[1].row(k).data();
-            double* xd = xd_.data();
-            double* yd = yd_.data();
-            const double* el = basis->data() + l;  // column-major: E(l, c) = el[c * n]
-            const double mkx = mu * kn * ex, mky = mu * kn * ey, ikt = 1.0 / kt;
-            for (int blk = 0; blk < 3; ++blk) {
-              const double bx = blk == 0 ? 1.0 : 0.0, by = blk == 1 ? 1.0 : 0.0;
-              const double zx = blk == 2 ? mkx : 0.0, zy = blk == 2 ? mky : 0.0;
-              for (int k = 0, c = blk * m; k < m; ++k, ++c) {
-                const double e = el[static_cast<Eigen::Index>(k) * n];
-                const double gx = kt * (bx * e - xd[c]);
-                const double gy = kt * (by * e - yd[c]);
-                const double pr = ex * gx + ey * gy;
-                const double tdx = rho * (gx - ex * pr) + zx * e;
-                const double tdy = rho * (gy - ey * pr) + zy * e;
-                rx[c] = tdx;
-                ry[c] = tdy;
-                xd[c] = bx * e - tdx * ikt;
-                yd[c] = by * e - tdy * ikt;
-              }
-            }
-            lin->dense_index[0].push_back(l);
-            lin->dense_index[1].push_back(l);
-          }
-          prev_stick = {false, false};
-        }
-      } else if (coupled) {
-        // full3d, exact_linear: elastic displacement e = w_t - d integrated over the step,
-        // slip radius linear within the step, from mu N(l-1)/kt to mu N(l)/kt.
-        const Eigen::Vector2d e0(w(lp, 0) - d[0], w(lp, 1) - d[1]);
-        const Eigen::Vector2d dw(wx - w(lp, 0), wy - w(lp, 1));
-        const double a_end = lim / kt;
-        const double a = mu * nprev / kt;
-        Eigen::Matrix<double, 2, 6> jl;
-        bool stuck = false;
-        const Eigen::Vector2d e1 = exact_linear_step(e0, dw, a, a_end, kD ? &jl : nullptr, &stuck);
-        tx = kt * e1.x();
-        ty = kt * e1.y();
-        d = {wx - e1.x(), wy - e1.y()};
-        if (stuck) {  // e1 = e0 + dw: dT = kt (dw_t(l) - dd), dd unchanged
-          rec_stick(0, l);
-          rec_stick(1, l);
-        } else {
-          if constexpr (kD) {
-            // de1 = J_e0 (dw_t(lp) - dd) + J_dw (dw_t(l) - dw_t(lp))
-            //       + J_a0 mu dN(lp)/kt + J_a1 mu dN(l)/kt;  dT = kt de1, dd = dw_t(l) - de1.
-            const double ca = mu * kn / kt;
-            const double cp = pressed_prev ? ca : 0.0;
-            const Eigen::Index k = static_cast<Eigen::Index>(lin->dense_index[0].size());
-            double* rx = lin->dense[0].row(k).data();
-            double* ry = lin->dense[1].row(k).data();
-            double* xd = xd_.data();
-            double* yd = yd_.data();
-            const double* el = basis->data() + l;
-            const double* ep = basis->data() + lp;
-            for (int blk = 0; blk < 3; ++blk) {
-              // de1_i = -J_i0 dd_x - J_i1 dd_y + u_i E(lp) + v_i E(l) within block blk
-              double u[2], v[2];
-              for (int i = 0; i < 2; ++i) {
-                u[i] = blk == 0 ? jl(i, 0) - jl(i, 2) : blk == 1 ? jl(i, 1) - jl(i, 3) : jl(i, 4) * cp;
-                v[i] = blk == 0 ? jl(i, 2) : blk == 1 ? jl(i, 3) : jl(i, 5) * ca;
-              }
-              const double bx = blk == 0 ? 1.0 : 0.0, by = blk == 1 ? 1.0 : 0.0;
-              for (int k = 0, c = blk * m; k < m; ++k, ++c) {
-                const Eigen::Index off = static_cast<Eigen::Index>(k) * n;
-                const double e = el[off], eprev = ep[off];
-                const double g0 = -jl(0, 0) * xd[c] - jl(0, 1) * yd[c] + u[0] * eprev + v[0] * e;
-                const double g1 = -jl(1, 0) * xd[c] - jl(1, 1) * yd[c] + u[1] * eprev + v[1] * e;
-                rx[c] = kt * g0;
-                ry[c] = kt * g1;
-                xd[c] = bx * e - g0;
-                yd[c] = by * e - g1;
-              }
-            }
-            lin->dense_index[0].push_back(l);
-            lin->dense_index[1].push_back(l);
-          }
-          prev_stick = {false, false};
-        }
-      } else {
-        // quasi3d (x and y) or 1d (x): independent 1D laws with limit mu N(l). Their slip is
-        // memoryless, so the damper derivative is always X_i = alpha E_i(s) + beta E_z(s) for
-        // the last slip or separation sample s (an "anchor"; 0 before any): no P-wide rows.
-        const int ndir = two_d ? 2 : 1;
-        const double ca = has_normal ? mu * kn / kt : 0.0;
-        for (int i = 0; i < ndir; ++i) {
-          const double wi = (i == 0) ? wx : wy;
-          const double wip = w(lp, i);
-          double t = 0.0;
-          if (!exact) {
-            const double ts = kt * (wi - d[i]);
-            if (std::abs(ts) <= lim) {
-              t = ts;
-              rec_anchor_stick(i, l);
-            } else {
-              const double sg = ts > 0.0 ? 1.0 : -1.0;
-              t = lim * sg;
-              d[i] = wi - t / kt;
-              // dT_i = mu kn sg E_z(l); X_i = E_i(l) - dT_i/kt
-              rec_slip(i, l, kt * ca * sg);
-              anchor[i] = {l, 1.0, -ca * sg};
-            }
-          } else {
-            // 1D: exact for w linear and the limit linear within the step: clamp to the start
-            // limit (a no-op up to round-off), add the increment, clamp to the end limit.
-            const double a_end = lim / kt;
-            const double a = mu * nprev / kt;
-            double e0 = wip - d[i];
-            double c_a = 0.0;  // d e0' / d a0 when the start is clamped
-            bool start_clamped = false;
-            if (std::abs(e0) > a) {
-              const double sg = e0 > 0.0 ? 1.0 : -1.0;
-              e0 = a * sg;
-              c_a = pressed_prev ? sg : 0.0;
-              start_clamped = true;
-            }
-            const double v = e0 + (wi - wip);
-            double e1 = v;
-            if (std::abs(v) > a_end) {  // slipping at the step end: de1 = sg mu kn E_z(l)/kt
-              const double sg = v > 0.0 ? 1.0 : -1.0;
-              e1 = a_end * sg;
-              rec_slip(i, l, kt * ca * sg);
-              anchor[i] = {l, 1.0, -ca * sg};
-            } else {
-              if (start_clamped) {
-                // e1 = a0 sg + w(l) - w(lp): the damper was reset at lp (X_i = E_i(lp) -
-                // c_a mu kn E_z(lp)/kt), then the step sticks.
-                anchor[i] = {lp, 1.0, -c_a * ca};
-              }
-              rec_anchor_stick(i, l);
-            }
-            t = kt * e1;
-            d[i] = wi - e1;
-          }
-          (i == 0 ? tx : ty) = t;
-        }
-      }
-
-      f(l, 0) = tx;
-      f(l, 1) = ty;
-      f(l, 2) = has_normal ? nl : 0.0;
-    }
-    status.periods = period;
-    const double change = std::max(std::abs(d[0] - d_start[0]), std::abs(d[1] - d_start[1]));
-    if (change <= tol) {
-      status.converged = true;
-      break;
+  if constexpr (kD) {
+    for (int i = 0; i < 2; ++i) {
+      lin->runs[i].clear();
+      lin->dense_index[i].clear();
+      lin->slip_weight[i].assign(coupled || i >= (two_d ? 2 : 1) ? 0 : n, 0.0);
     }
   }
-  return status;
+  for (int l = 0; l < n; ++l) {
+    const int lp = (l == 0) ? n - 1 : l - 1;
+    const double wx = w(l, 0);
+    const double wy = two_d ? w(l, 1) : 0.0;
+    double nl = has_normal ? n0 + kn * w(l, 2) : n0;
+    const bool pressed = nl > 0.0;
+    if (!pressed) nl = 0.0;
+    double nprev = has_normal ? n0 + kn * w(lp, 2) : n0;  // N(l-1), for exact_linear
+    const bool pressed_prev = nprev > 0.0;
+    if (!pressed_prev) nprev = 0.0;
+    const double lim = mu * nl;
+    double tx = 0.0, ty = 0.0;
+    auto e_row = [&](int row) { return basis->row(row); };
+    if constexpr (kD) lin->pressed[l] = (pressed && has_normal) ? 1 : 0;
+
+    if (!pressed || !(lim > 0.0)) {
+      // Separation (or no friction): no tangential force, the damper follows.
+      d = {wx, wy};
+      rec_none(0);
+      rec_none(1);
+      anchor[0] = {l, 1.0, 0.0};
+      anchor[1] = {l, 1.0, 0.0};
+      if (track) {
+        dd0.setZero();
+        slipped_ = true;
+      }
+      if constexpr (kD) {
+        xd_.setZero();
+        xd_.segment(0, m) = e_row(l);
+        if (two_d) {
+          yd_.setZero();
+          yd_.segment(m, m) = e_row(l);
+        }
+      }
+    } else if (coupled && !exact) {
+      // full3d, radial return.
+      const double tsx = kt * (wx - d[0]);
+      const double tsy = kt * (wy - d[1]);
+      const double nt = std::sqrt(tsx * tsx + tsy * tsy);
+      if (nt <= lim) {
+        tx = tsx;
+        ty = tsy;
+        rec_stick(0, l);  // dT = kt (dw_t - dd), dd unchanged
+        rec_stick(1, l);
+      } else {
+        const double ex = tsx / nt, ey = tsy / nt;
+        tx = lim * ex;
+        ty = lim * ey;
+        d = {wx - tx / kt, wy - ty / kt};
+        const double rho = lim / nt;
+        if (track) {
+          // d(d_start) only: dT* = -kt D, dT = rho (I - e e^T) dT*, D <- -dT/kt.
+          Eigen::Matrix2d proj;
+          proj << 1.0 - ex * ex, -ex * ey, -ex * ey, 1.0 - ey * ey;
+          const Eigen::Matrix2d md = rho * proj * dd0;
+          if constexpr (kD) dense_q_.push_back(-kt * md);
+          dd0 = md;
+          slipped_ = true;
+        }
+        if constexpr (kD) {
+          // dT = mu dN dir + (mu N/|T*|)(I - dir dir^T) dT*,  dT* = kt (dw_t - dd),
+          // dd = dw_t - dT/kt; one fused pass over the P columns, written straight into
+          // the dense rows of this sample.
+          const Eigen::Index k = static_cast<Eigen::Index>(lin->dense_index[0].size());
+          double* rx = lin->dense[0].row(k).data();
+          double* ry = lin->dense[1].row(k).data();
+          double* xd = xd_.data();
+          double* yd = yd_.data();
+          const double* el = basis->data() + l;  // column-major: E(l, c) = el[c * n]
+          const double mkx = mu * kn * ex, mky = mu * kn * ey, ikt = 1.0 / kt;
+          for (int blk = 0; blk < 3; ++blk) {
+            const double bx = blk == 0 ? 1.0 : 0.0, by = blk == 1 ? 1.0 : 0.0;
+            const double zx = blk == 2 ? mkx : 0.0, zy = blk == 2 ? mky : 0.0;
+            for (int k = 0, c = blk * m; k < m; ++k, ++c) {
+              const double e = el[static_cast<Eigen::Index>(k) * n];
+              const double gx = kt * (bx * e - xd[c]);
+              const double gy = kt * (by * e - yd[c]);
+              const double pr = ex * gx + ey * gy;
+              const double tdx = rho * (gx - ex * pr) + zx * e;
+              const double tdy = rho * (gy - ey * pr) + zy * e;
+              rx[c] = tdx;
+              ry[c] = tdy;
+              xd[c] = bx * e - tdx * ikt;
+              yd[c] = by * e - tdy * ikt;
+            }
+          }
+          lin->dense_index[0].push_back(l);
+          lin->dense_index[1].push_back(l);
+        }
+        prev_stick = {false, false};
+      }
+    } else if (coupled) {
+      // full3d, exact_linear: elastic displacement e = w_t - d integrated over the step,
+      // slip radius linear within the step, from mu N(l-1)/kt to mu N(l)/kt.
+      const Eigen::Vector2d e0(w(lp, 0) - d[0], w(lp, 1) - d[1]);
+      const Eigen::Vector2d dw(wx - w(lp, 0), wy - w(lp, 1));
+      const double a_end = lim / kt;
+      const double a = mu * nprev / kt;
+      Eigen::Matrix<double, 2, 6> jl;
+      bool stuck = false;
+      Eigen::Vector2d e1 = exact_linear_step(e0, dw, a, a_end, kD ? &jl : nullptr, &stuck);
+      // Forces-only tracking: the step's Jacobian only where it does not simply stick.
+      if (!kD && track && !stuck) e1 = exact_linear_step(e0, dw, a, a_end, &jl, &stuck);
+      tx = kt * e1.x();
+      ty = kt * e1.y();
+      d = {wx - e1.x(), wy - e1.y()};
+      if (stuck) {  // e1 = e0 + dw: dT = kt (dw_t(l) - dd), dd unchanged
+        rec_stick(0, l);
+        rec_stick(1, l);
+      } else {
+        if (track) {
+          // d(d_start) only: de1 = J_e0 (-D), dT = kt de1, D <- -de1.
+          const Eigen::Matrix2d md = jl.leftCols<2>() * dd0;
+          if constexpr (kD) dense_q_.push_back(-kt * md);
+          dd0 = md;
+          slipped_ = true;
+        }
+        if constexpr (kD) {
+          // de1 = J_e0 (dw_t(lp) - dd) + J_dw (dw_t(l) - dw_t(lp))
+          //       + J_a0 mu dN(lp)/kt + J_a1 mu dN(l)/kt;  dT = kt de1, dd = dw_t(l) - de1.
+          const double ca = mu * kn / kt;
+          const double cp = pressed_prev ? ca : 0.0;
+          const Eigen::Index k = static_cast<Eigen::Index>(lin->dense_index[0].size());
+          double* rx = lin->dense[0].row(k).data();
+          double* ry = lin->dense[1].row(k).data();
+          double* xd = xd_.data();
+          double* yd = yd_.data();
+          const double* el = basis->data() + l;
+          const double* ep = basis->data() + lp;
+          for (int blk = 0; blk < 3; ++blk) {
+            // de1_i = -J_i0 dd_x - J_i1 dd_y + u_i E(lp) + v_i E(l) within block blk
+            double u[2], v[2];
+            for (int i = 0; i < 2; ++i) {
+              u[i] = blk == 0 ? jl(i, 0) - jl(i, 2) : blk == 1 ? jl(i, 1) - jl(i, 3) : jl(i, 4) * cp;
+              v[i] = blk == 0 ? jl(i, 2) : blk == 1 ? jl(i, 3) : jl(i, 5) * ca;
+            }
+            const double bx = blk == 0 ? 1.0 : 0.0, by = blk == 1 ? 1.0 : 0.0;
+            for (int k = 0, c = blk * m; k < m; ++k, ++c) {
+              const Eigen::Index off = static_cast<Eigen::Index>(k) * n;
+              const double e = el[off], eprev = ep[off];
+              const double g0 = -jl(0, 0) * xd[c] - jl(0, 1) * yd[c] + u[0] * eprev + v[0] * e;
+              const double g1 = -jl(1, 0) * xd[c] - jl(1, 1) * yd[c] + u[1] * eprev + v[1] * e;
+              rx[c] = kt * g0;
+              ry[c] = kt * g1;
+              xd[c] = bx * e - g0;
+              yd[c] = by * e - g1;
+            }
+          }
+          lin->dense_index[0].push_back(l);
+          lin->dense_index[1].push_back(l);
+        }
+        prev_stick = {false, false};
+      }
+    } else {
+      // quasi3d (x and y) or 1d (x): independent 1D laws with limit mu N(l). Their slip is
+      // memoryless, so the damper derivative is always X_i = alpha E_i(s) + beta E_z(s) for
+      // the last slip or separation sample s (an "anchor"; 0 before any): no P-wide rows.
+      const int ndir = two_d ? 2 : 1;
+      const double ca = has_normal ? mu * kn / kt : 0.0;
+      for (int i = 0; i < ndir; ++i) {
+        const double wi = (i == 0) ? wx : wy;
+        const double wip = w(lp, i);
+        double t = 0.0;
+        if (!exact) {
+          const double ts = kt * (wi - d[i]);
+          if (std::abs(ts) <= lim) {
+            t = ts;
+            rec_anchor_stick(i, l);
+          } else {
+            const double sg = ts > 0.0 ? 1.0 : -1.0;
+            t = lim * sg;
+            d[i] = wi - t / kt;
+            // dT_i = mu kn sg E_z(l); X_i = E_i(l) - dT_i/kt
+            rec_slip(i, l, kt * ca * sg);
+            anchor[i] = {l, 1.0, -ca * sg};
+          }
+        } else {
+          // 1D: exact for w linear and the limit linear within the step: clamp to the start
+          // limit (a no-op up to round-off), add the increment, clamp to the end limit.
+          const double a_end = lim / kt;
+          const double a = mu * nprev / kt;
+          double e0 = wip - d[i];
+          double c_a = 0.0;  // d e0' / d a0 when the start is clamped
+          bool start_clamped = false;
+          if (std::abs(e0) > a) {
+            const double sg = e0 > 0.0 ? 1.0 : -1.0;
+            e0 = a * sg;
+            c_a = pressed_prev ? sg : 0.0;
+            start_clamped = true;
+          }
+          const double v = e0 + (wi - wip);
+          double e1 = v;
+          if (std::abs(v) > a_end) {  // slipping at the step end: de1 = sg mu kn E_z(l)/kt
+            const double sg = v > 0.0 ? 1.0 : -1.0;
+            e1 = a_end * sg;
+            rec_slip(i, l, kt * ca * sg);
+            anchor[i] = {l, 1.0, -ca * sg};
+          } else {
+            if (start_clamped) {
+              // e1 = a0 sg + w(l) - w(lp): the damper was reset at lp (X_i = E_i(lp) -
+              // c_a mu kn E_z(lp)/kt), then the step sticks.
+              anchor[i] = {lp, 1.0, -c_a * ca};
+            }
+            rec_anchor_stick(i, l);
+          }
+          t = kt * e1;
+          d[i] = wi - e1;
+        }
+        (i == 0 ? tx : ty) = t;
+      }
+    }
+
+    f(l, 0) = tx;
+    f(l, 1) = ty;
+    f(l, 2) = has_normal ? nl : 0.0;
+  }
 }
 
 template PeriodicStatus PeriodicLaw::run<true>(const PairParameters&, const Eigen::MatrixX3d&,

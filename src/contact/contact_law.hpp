@@ -11,15 +11,30 @@
 // orbits); exact_linear takes w_t and the slip radius mu N/kt linear within each step and
 // integrates the stick/slip evolution exactly (second order; see exact_linear_step). For the
 // 1D laws (quasi3d per axis, 1d) both are the exact clamp and coincide.
-// The periodic steady state is found by repeating the period from d = 0 until d at the
-// period's end repeats (|d_end - d_start| <= period_tolerance * max_l |w_t(l)|), capped by
-// max_periods; the status says whether it converged.
+// The periodic steady state: the period map d_end = Phi(d_start) of the damper position.
+// Uncoupled models (quasi3d, 1d): the period is repeated from d = 0 until d at the period's
+// end repeats (their slip is memoryless: 2 periods typically). Coupled model (full3d): the
+// same plain repetition for up to 4 periods (most states repeat in 2 to 4); if d still moves,
+// the fixed point d* = Phi(d*) is solved by a safeguarded Newton iteration on
+// g(d) = Phi(d) - d from there, with the 2x2 derivative Phi_d carried through each period
+// (contraction where the pair slips, the identity in pure stick where every d is periodic and
+// d = 0 is kept; exactly neutral directions are left alone): a Newton step is accepted when
+// it reduces max|g|, else the plain repetition d <- Phi(d) is taken. Both stop when
+// |d_end - d_start| <= period_tolerance * max_l |w_t(l)| for the returned period (the last
+// one computed, started from the accepted iterate), capped by max_periods periods; the
+// status says whether it converged. Deterministic: same input, same iterates.
 //
 // Derivatives: the caller gives a sampled basis E (N x m). Unknown c of direction j
 // (j = 0 x, 1 y, 2 z; column j*m + k, P = n_directions * m columns) moves w_j(l) by
 // E(l, k). The law returns dF_i(l)/dc (LinearizedPeriod), carried exactly through stick,
 // slip, separation and all repeated periods (the derivative of the discrete map as
-// computed, which a central difference of the same map reproduces).
+// computed, which a central difference of the same map reproduces). Coupled model: the
+// derivative of the converged periodic map, i.e. of the period started from d*(c) with
+// dd*/dc = (I - Phi_d)^{-1} Phi_c at the fixed point (the implicit function theorem; exact
+// when the iteration converged, whatever path it took). If the returned period sticks
+// throughout (Phi_d = I, Phi_c = 0: every d is periodic) d* is held, dd*/dc = 0; likewise
+// along exactly neutral directions of Phi_d (singular values of I - Phi_d <= 1e-10). States
+// that repeat within the 4 plain periods keep the derivative carried through them.
 #include <Eigen/Core>
 #include <array>
 #include <optional>
@@ -76,7 +91,9 @@ struct LawOptions {
 /// Outcome of the steady-state iteration.
 struct PeriodicStatus {
   bool converged = true;  ///< d repeated within tolerance before the cap
-  int periods = 0;        ///< periods computed (the last one is returned)
+  int periods = 0;        ///< periods computed (the last one is returned); after a Newton
+                          ///< iteration (full3d) the derivative re-evaluates the last one
+                          ///< once more, not counted
 };
 
 /// Row-major dense matrix: one row per time sample, written sample by sample.
@@ -136,10 +153,33 @@ class PeriodicLaw {
   PeriodicStatus run(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
                      const Eigen::MatrixXd* basis, LinearizedPeriod* lin);
 
+  struct Anchor {  // uncoupled models: damper derivative X_i = alpha E_i(s) + beta E_z(s)
+    int s = 0;
+    double alpha = 0.0, beta = 0.0;
+  };
+  /// One period from the current state (d_, anchor_, xd_, yd_), which it advances. track:
+  /// also carry D_ = d(d)/d(d_start) (2 x 2, coupled model) and, with kWithDerivative, the
+  /// sensitivities of the recorded rows to d_start (run_d_, dense_q_).
+  template <bool kWithDerivative>
+  void period(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
+              const Eigen::MatrixXd* basis, LinearizedPeriod* lin, bool track);
+
   LawOptions options_;
   // Derivative scratch of the coupled model: d(damper position)/dc, one row (P) per
   // tangential direction.
   Eigen::RowVectorXd xd_, yd_;
+  // Period state: damper position [m], anchors of the uncoupled models.
+  std::array<double, 2> d_{0.0, 0.0};
+  std::array<Anchor, 2> anchor_{};
+  std::array<double, 2> last_start_{0.0, 0.0};  // start of the last plain period (coupled)
+  // Coupled model: D_ = d(d)/d(d_start) within the period; slipped_: a sample of the period
+  // slipped or separated (else Phi_d = I); per stick run r of direction i the D_ of the run
+  // (X_i,r moves by row i of it times dd*/dc), per dense row k dT/d(d_start) (2 x 2).
+  Eigen::Matrix2d dd_start_ = Eigen::Matrix2d::Identity();
+  bool slipped_ = false;
+  std::array<std::vector<Eigen::Matrix2d>, 2> run_d_;
+  std::vector<Eigen::Matrix2d> dense_q_;
+  Eigen::MatrixXd fixed_point_dc_;  // 2 x P: dd*/dc
 };
 
 /// One exact_linear step of the coupled law in elastic-displacement form (exposed for tests).

@@ -259,9 +259,9 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
 
     // Leaving the range: the last point is put on the boundary by Newton at fixed lambda.
     const bool past_end = direction * (lambda - o.lambda_end) > lambda_slack;
-    const bool before_start = direction * (lambda - o.lambda_start) < -lambda_slack;
+    const bool before_start = direction * (lambda - o.lambda_start) < -lambda_slack - o.start_slack;
     if (past_end || before_start) {
-      const double bound = past_end ? o.lambda_end : o.lambda_start;
+      const double bound = past_end ? o.lambda_end : o.lambda_start - direction * o.start_slack;
       const BranchPoint& prev = branch.points.back();
       const double w = (bound - prev.lambda) / (lambda - prev.lambda);
       Eigen::VectorXd yb = s.to_scaled(prev.x + w * (s.x_of(y) - prev.x), bound);

@@ -55,6 +55,9 @@ struct ArclengthOptions {
   int target_newton_iterations = 4;  ///< grow the step below, shrink above
   double steep_ratio = 30.0;      ///< "a" of the steep-branch rule (20 to 40)
   int turning_backtrack = 2;      ///< points dropped before retracing a turning point
+  /// How far beyond lambda_start (against the direction of travel, in lambda units) the
+  /// branch may go before it counts as having left the range (0: not at all).
+  double start_slack = 0.0;
   bool validate(std::vector<std::string>* errors) const;
 };
 

@@ -178,7 +178,8 @@ continuation::Branch ReducedEquations::solve_by_excitation_homotopy(double frequ
   o.lambda_scale = 1.0;
   o.initial_step = 0.05;
   o.max_step = 4.0;
-  o.max_points = std::min(o.max_points, 500);  // a start that needs more is not worth waiting for
+  o.max_points = std::min(o.max_points, 2000);  // a start that needs more is not worth waiting for
+  o.start_slack = 1.0;  // the path may fold back through s < 0 (the excitation reversed)
   const double saved = excitation_scale_;
   excitation_scale_ = 0.0;
   const Eigen::VectorXd start = stuck_solution(frequency_hz);
