@@ -286,3 +286,45 @@ TEST(SectorForced, HugeFrictionGivesTheLinearSectorWithContactSprings) {
 
 }  // namespace
 }  // namespace shroudsim::frf
+
+namespace shroudsim::frf {
+namespace {
+
+TEST(SectorReceptance, ConjugatedBasisAndFactorServeHarmonicIndexNbMinusH) {
+  // The modal stage serves h > Nb/2 from h' = Nb - h by conjugation (modes and K factor):
+  // the receptance built that way must equal the direct solve of h itself.
+  const Fixture f;
+  std::vector<SectorContactPair> pairs;
+  for (std::size_t i = 0; i < 3; ++i) {
+    SectorContactPair p;
+    p.low_node = f.mesh.shroud_pairs[i * 2].first;
+    p.high_node = f.mesh.shroud_pairs[i * 2].second;
+    p.frame = Eigen::AngleAxis<double>(0.4 * i + 0.1, Eigen::Vector3d(1, -1, 2).normalized()).toRotationMatrix();
+    pairs.push_back(p);
+  }
+  SectorForcing forcing;
+  forcing.engine_order = 5;  // harmonic 1 -> h = 5 = conj of 3
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, 0.5, -0.25);
+  forcing.damping_ratio = 0.0;
+  modal::ModalOptions mo;
+  mo.modes = 20;
+  auto r3 = modal::solve_harmonic(*f.sector, 3, mo);
+  ASSERT_TRUE(r3.report.ok());
+  std::map<int, modal::ModalBasis> bases{{5, r3.basis.conjugate(5)}};
+  const modal::StiffnessFactor k3 = modal::factor_harmonic_stiffness(*f.sector, 3);
+  const modal::StiffnessFactor k0 = modal::factor_harmonic_stiffness(*f.sector, 0);
+  auto factor = [&](int h) { return h == 5 ? k3.conjugate() : k0; };
+  const SectorLinearPart part(*f.sector, bases, factor, pairs, forcing, 1);
+  const double w = 0.5 * bases.at(5).omega[0];
+  HarmonicReceptance rec;
+  part.harmonic(1, w, rec);
+  const Eigen::MatrixXcd q = direct(f, pairs, forcing, 5, w);
+  const int c = part.n_contact();
+  EXPECT_LT((rec.G - q.topLeftCorner(c, c)).norm(), 1e-3 * q.topLeftCorner(c, c).norm());
+  EXPECT_LT((rec.w_lin - q.block(0, c + 3, c, 1)).norm(), 1e-3 * q.block(0, c + 3, c, 1).norm());
+}
+
+}  // namespace
+}  // namespace shroudsim::frf
