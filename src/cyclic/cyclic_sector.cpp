@@ -1,4 +1,5 @@
 #include "cyclic/cyclic_sector.hpp"
+#include "mesh/checks.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,12 +14,7 @@ using linalg::Complex;
 using linalg::SparseMatrixC;
 using linalg::SparseMatrixD;
 
-Eigen::Matrix3d rotation_z(double angle) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  Eigen::Matrix3d R;
-  R << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
-  return R;
-}
+Eigen::Matrix3d rotation_z(double angle) { return mesh::rotation_z(angle); }
 
 int nodal_diameter(int h, int sectors) {
   const int m = ((h % sectors) + sectors) % sectors;

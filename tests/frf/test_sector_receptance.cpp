@@ -38,6 +38,21 @@ struct Fixture {
   }
 };
 
+/// `count` matched shroud pairs (every `stride`-th), frames turned about `axis` by
+/// offset + step * i.
+std::vector<SectorContactPair> some_pairs(const Fixture& f, std::size_t count, std::size_t stride, double offset,
+                                          double step, const Eigen::Vector3d& axis) {
+  std::vector<SectorContactPair> pairs;
+  for (std::size_t i = 0; i < count; ++i) {
+    SectorContactPair p;
+    p.low_node = f.mesh.shroud_pairs[i * stride].first;
+    p.high_node = f.mesh.shroud_pairs[i * stride].second;
+    p.frame = Eigen::AngleAxis<double>(offset + step * static_cast<double>(i), axis.normalized()).toRotationMatrix();
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
 /// Direct Q = C R C^H with R = T_h (K_h - W^2 M_h)^-1 T_h^H (no damping), via the same C rows
 /// the sector part uses: contact pairs, response node, excitation force.
 Eigen::MatrixXcd direct(const Fixture& f, const std::vector<SectorContactPair>& pairs, const SectorForcing& forcing,
@@ -209,14 +224,9 @@ TEST(SectorForced, HugeFrictionGivesTheLinearSectorWithContactSprings) {
   // (kt, kt, kn in each pair's frame, joining q and the next sector's p') assembled into
   // K_h, solved directly: U = D T_h (K_h + S_h - W^2 M_h)^-1 T_h^H f.
   const Fixture f;
-  std::vector<SectorContactPair> pairs;
+  const auto pairs = some_pairs(f, 4, 2, 0.0, 0.7, Eigen::Vector3d(0.2, 1, 0.5));
   std::vector<contact::PairParameters> params;
-  for (std::size_t i = 0; i < 4; ++i) {
-    SectorContactPair p;
-    p.low_node = f.mesh.shroud_pairs[i * 2].first;
-    p.high_node = f.mesh.shroud_pairs[i * 2].second;
-    p.frame = Eigen::AngleAxis<double>(0.7 * i, Eigen::Vector3d(0.2, 1, 0.5).normalized()).toRotationMatrix();
-    pairs.push_back(p);
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
     contact::PairParameters pp;
     pp.tangential_stiffness = 3e6;
     pp.normal_stiffness = 5e6;
@@ -294,14 +304,7 @@ TEST(SectorReceptance, ConjugatedBasisAndFactorServeHarmonicIndexNbMinusH) {
   // The modal stage serves h > Nb/2 from h' = Nb - h by conjugation (modes and K factor):
   // the receptance built that way must equal the direct solve of h itself.
   const Fixture f;
-  std::vector<SectorContactPair> pairs;
-  for (std::size_t i = 0; i < 3; ++i) {
-    SectorContactPair p;
-    p.low_node = f.mesh.shroud_pairs[i * 2].first;
-    p.high_node = f.mesh.shroud_pairs[i * 2].second;
-    p.frame = Eigen::AngleAxis<double>(0.4 * i + 0.1, Eigen::Vector3d(1, -1, 2).normalized()).toRotationMatrix();
-    pairs.push_back(p);
-  }
+  const auto pairs = some_pairs(f, 3, 2, 0.1, 0.4, Eigen::Vector3d(1, -1, 2));
   SectorForcing forcing;
   forcing.engine_order = 5;  // harmonic 1 -> h = 5 = conj of 3
   forcing.excitation_node = f.mesh.n_nodes() / 2;
