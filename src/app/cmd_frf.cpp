@@ -120,6 +120,50 @@ int cmd_frf(Context& ctx) {
     start = equations.linear_motion(ao.lambda_start);
     started = continuation::newton_fixed(equations, start, ao.lambda_start, ao) >= 0;
   }
+  if (!started && eo.n_harmonics > 1) {
+    // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
+    // each new harmonic starting at zero (higher harmonics are small corrections).
+    log::info("frf: start point by harmonic stepping (H = 1 .. " + std::to_string(eo.n_harmonics) + ")");
+    Eigen::VectorXd prev;
+    int prev_h = 0;
+    for (int h = 1; h <= eo.n_harmonics; ++h) {
+      hbm::ContactEvaluatorOptions step_options = eo;
+      step_options.n_harmonics = h;
+      hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
+      forced::ReducedEquations step_equations(*model.linear, step_evaluator);
+      continuation::ArclengthOptions so = ao;
+      so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
+      Eigen::VectorXd w;
+      if (h == 1) {
+        w = step_equations.stuck_solution(ao.lambda_start);
+        if (continuation::newton_fixed(step_equations, w, ao.lambda_start, so) < 0) {
+          w = step_equations.stuck_solution(ao.lambda_start);
+          if (step_equations.solve_by_excitation_homotopy(ao.lambda_start, so, w).status !=
+              continuation::BranchStatus::kReachedEnd)
+            break;
+        }
+      } else {
+        w = Eigen::VectorXd::Zero(step_equations.size());
+        const auto& lo = step_evaluator.pair_layout();
+        const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
+        for (int p = 0; p < step_evaluator.n_pairs(); ++p)
+          for (int d = 0; d < lo.n_directions(); ++d)
+            for (int n = 0; n <= prev_h; ++n)
+              for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
+                if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
+                w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
+              }
+        if (continuation::newton_fixed(step_equations, w, ao.lambda_start, so) < 0) break;
+      }
+      prev = w;
+      prev_h = h;
+    }
+    if (prev_h == eo.n_harmonics) {
+      start = prev;
+      started = true;
+      ctx.report.section("frf")["start"] = "harmonic stepping";
+    }
+  }
   if (!started) {
     start = equations.stuck_solution(ao.lambda_start);
     const continuation::Branch h = equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start);
