@@ -243,7 +243,23 @@ ModalResult solve_dense(const linalg::SparsePair<S>& km, int h, const ModalOptio
 }
 
 template <typename S>
-ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOptions& options) {
+std::shared_ptr<linalg::CholmodFactor<S>>& reuse_slot(FactorReuse& reuse) {
+  if constexpr (kIsComplex<S>)
+    return reuse.complex;
+  else
+    return reuse.real;
+}
+template <typename S>
+Eigen::Index& reuse_nonzeros(FactorReuse& reuse) {
+  if constexpr (kIsComplex<S>)
+    return reuse.complex_nonzeros;
+  else
+    return reuse.real_nonzeros;
+}
+
+template <typename S>
+ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOptions& options,
+                          FactorReuse* reuse) {
   const Eigen::Index n = km.K.rows();
   const Eigen::Index real_n = kIsComplex<S> ? 2 * n : n;
   ModalReport report;
@@ -254,12 +270,25 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
   report.requested_eigenvalues = static_cast<int>(nev);
 
   log::Stopwatch watch;
-  auto factor = std::make_shared<linalg::CholmodFactor<S>>(options.factor_method);
+  std::shared_ptr<linalg::CholmodFactor<S>> factor;
   {
     linalg::SparseMatrix<S> A = options.shift == 0.0 ? linalg::SparseMatrix<S>(km.K)
                                                      : linalg::SparseMatrix<S>(km.K - S(options.shift) * km.M);
     A.makeCompressed();
-    factor->compute(A);
+    if (reuse && reuse_slot<S>(*reuse) && reuse_slot<S>(*reuse)->rows() == A.rows() &&
+        reuse_nonzeros<S>(*reuse) == A.nonZeros()) {
+      factor = reuse_slot<S>(*reuse);
+      factor->factorize(A);  // symbolic analysis of an earlier solve, same pattern
+    } else {
+      factor = std::make_shared<linalg::CholmodFactor<S>>(options.factor_method);
+      factor->compute(A);
+      if (reuse) {
+        reuse_slot<S>(*reuse) = factor;
+        reuse_nonzeros<S>(*reuse) = A.nonZeros();
+        ++reuse->analyses;
+      }
+    }
+    if (reuse) ++reuse->factorizations;
   }
   report.factor_seconds = watch.seconds();
   report.factor_nonzeros = factor->factor_nonzeros();
@@ -371,7 +400,7 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
     for (std::size_t j = 0; j < vecs.size(); ++j) phi.col(static_cast<Eigen::Index>(j)) = vecs[j];
     result = finish<S>(km, h, lambda, phi, options, report);
   }
-  if (result.report.ok() && options.shift == 0.0) {
+  if (result.report.ok() && options.shift == 0.0 && !reuse) {
     if constexpr (kIsComplex<S>)
       result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(factor), false);
     else
@@ -381,7 +410,8 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
 }
 
 template <typename S>
-ModalResult solve_any(const linalg::SparsePair<S>& km, int h, const ModalOptions& options) {
+ModalResult solve_any(const linalg::SparsePair<S>& km, int h, const ModalOptions& options,
+                      FactorReuse* reuse = nullptr) {
   std::vector<std::string> errors;
   SHROUDSIM_CHECK(options.validate(&errors), errors.empty() ? "invalid ModalOptions" : errors.front());
   SHROUDSIM_CHECK(km.K.rows() == km.K.cols() && km.M.rows() == km.K.rows() && km.M.cols() == km.K.rows(),
@@ -391,7 +421,7 @@ ModalResult solve_any(const linalg::SparsePair<S>& km, int h, const ModalOptions
   const Eigen::Index real_n = kIsComplex<S> ? 2 * n : n;
   const Eigen::Index nev = kIsComplex<S> ? 2 * options.modes + 4 : options.modes;
   if (n <= kDenseThreshold || nev + 1 >= real_n) return solve_dense<S>(km, h, options);
-  return solve_spectra<S>(km, h, options);
+  return solve_spectra<S>(km, h, options, reuse);
 }
 
 }  // namespace
@@ -402,6 +432,16 @@ ModalResult solve_modes(const linalg::SparsePair<double>& km, int h, const Modal
 
 ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int h, const ModalOptions& options) {
   return solve_any<Complex>(km, h, options);
+}
+
+ModalResult solve_modes(const linalg::SparsePair<double>& km, int h, const ModalOptions& options,
+                        FactorReuse& reuse) {
+  return solve_any<double>(km, h, options, &reuse);
+}
+
+ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int h, const ModalOptions& options,
+                        FactorReuse& reuse) {
+  return solve_any<Complex>(km, h, options, &reuse);
 }
 
 }  // namespace shroudsim::modal

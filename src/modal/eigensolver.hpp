@@ -120,4 +120,23 @@ ModalResult solve_modes(const linalg::SparsePair<double>& km, int harmonic_index
 /// Lowest options.modes modes of a complex Hermitian pair (real 2n embedding).
 ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int harmonic_index, const ModalOptions& options);
 
+/// A CHOLMOD symbolic analysis kept across solves of matrices with one sparsity pattern
+/// (a speed sweep K + Omega^2 D: the same pattern at every speed). The first solve given a
+/// FactorReuse analyzes and factorizes; later ones of the same size only refactorize
+/// numerically (a matrix of another size or number of stored entries is analyzed afresh;
+/// the caller guarantees that equal counts mean an equal pattern). Not thread-safe: one per
+/// worker. Solves given a FactorReuse return no StiffnessFactor (the factor is overwritten
+/// by the next solve).
+struct FactorReuse {
+  std::shared_ptr<linalg::CholmodFactor<double>> real;
+  std::shared_ptr<linalg::CholmodFactor<Complex>> complex;
+  Eigen::Index real_nonzeros = -1, complex_nonzeros = -1;  ///< stored entries of the analyzed patterns
+  int analyses = 0;           ///< symbolic analyses done through this object
+  int factorizations = 0;     ///< numeric factorizations done through this object
+};
+ModalResult solve_modes(const linalg::SparsePair<double>& km, int harmonic_index, const ModalOptions& options,
+                        FactorReuse& reuse);
+ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int harmonic_index, const ModalOptions& options,
+                        FactorReuse& reuse);
+
 }  // namespace shroudsim::modal
