@@ -112,72 +112,78 @@ int cmd_frf(Context& ctx) {
   log::info("frf: " + model.linear->describe() + ", " + std::to_string(evaluator.n_pairs()) + " contact pairs, " +
             std::to_string(equations.size()) + " unknowns (H = " + std::to_string(c.hbm.harmonics) +
             ", N = " + std::to_string(c.hbm.time_samples) + ", " + c.contact.model + ", " + c.hbm.jacobian + " Jacobian)");
-  // Start: Newton from the stuck-contact solution; where it fails (Newton cycling between
-  // contact states), continuation in the excitation level from the preload-only state.
-  Eigen::VectorXd start = equations.stuck_solution(ao.lambda_start);
-  bool started = continuation::newton_fixed(equations, start, ao.lambda_start, ao) >= 0;
-  if (!started) {  // second guess: the free response (contacts open or sliding freely)
-    start = equations.linear_motion(ao.lambda_start);
-    started = continuation::newton_fixed(equations, start, ao.lambda_start, ao) >= 0;
-  }
-  if (!started && eo.n_harmonics > 1) {
-    // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
-    // each new harmonic starting at zero (higher harmonics are small corrections).
-    log::info("frf: start point by harmonic stepping (H = 1 .. " + std::to_string(eo.n_harmonics) + ")");
-    Eigen::VectorXd prev;
-    int prev_h = 0;
-    for (int h = 1; h <= eo.n_harmonics; ++h) {
-      hbm::ContactEvaluatorOptions step_options = eo;
-      step_options.n_harmonics = h;
-      hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
-      forced::ReducedEquations step_equations(*model.linear, step_evaluator);
-      continuation::ArclengthOptions so = ao;
-      so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
-      Eigen::VectorXd w;
-      if (h == 1) {
-        w = step_equations.stuck_solution(ao.lambda_start);
-        if (continuation::newton_fixed(step_equations, w, ao.lambda_start, so) < 0) {
-          w = step_equations.stuck_solution(ao.lambda_start);
-          if (step_equations.solve_by_excitation_homotopy(ao.lambda_start, so, w).status !=
-              continuation::BranchStatus::kReachedEnd)
-            break;
+  // Start at frequency f: Newton from the stuck-contact solution; where it fails (Newton
+  // cycling between contact states), from the free response, then harmonic stepping, then
+  // continuation in the excitation level from the preload-only state. `how` says which.
+  auto start_at = [&](double f, std::string& how) -> Eigen::VectorXd {
+    how = "stuck contact";
+    Eigen::VectorXd start = equations.stuck_solution(f);
+    if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
+    how = "free response";
+    start = equations.linear_motion(f);
+    if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
+    if (eo.n_harmonics > 1) {
+      // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
+      // each new harmonic starting at zero (higher harmonics are small corrections).
+      log::info("frf: start point at " + io::format_number(f) + " Hz by harmonic stepping (H = 1 .. " +
+                std::to_string(eo.n_harmonics) + ")");
+      Eigen::VectorXd prev;
+      int prev_h = 0;
+      for (int h = 1; h <= eo.n_harmonics; ++h) {
+        hbm::ContactEvaluatorOptions step_options = eo;
+        step_options.n_harmonics = h;
+        hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
+        forced::ReducedEquations step_equations(*model.linear, step_evaluator);
+        continuation::ArclengthOptions so = ao;
+        so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
+        Eigen::VectorXd w;
+        if (h == 1) {
+          w = step_equations.stuck_solution(f);
+          if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
+            w = step_equations.stuck_solution(f);
+            if (step_equations.solve_by_excitation_homotopy(f, so, w).status != continuation::BranchStatus::kReachedEnd)
+              break;
+          }
+        } else {
+          w = Eigen::VectorXd::Zero(step_equations.size());
+          const auto& lo = step_evaluator.pair_layout();
+          const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
+          for (int p = 0; p < step_evaluator.n_pairs(); ++p)
+            for (int d = 0; d < lo.n_directions(); ++d)
+              for (int n = 0; n <= prev_h; ++n)
+                for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
+                  if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
+                  w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
+                }
+          if (continuation::newton_fixed(step_equations, w, f, so) < 0) break;
         }
-      } else {
-        w = Eigen::VectorXd::Zero(step_equations.size());
-        const auto& lo = step_evaluator.pair_layout();
-        const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
-        for (int p = 0; p < step_evaluator.n_pairs(); ++p)
-          for (int d = 0; d < lo.n_directions(); ++d)
-            for (int n = 0; n <= prev_h; ++n)
-              for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
-                if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
-                w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
-              }
-        if (continuation::newton_fixed(step_equations, w, ao.lambda_start, so) < 0) break;
+        prev = w;
+        prev_h = h;
       }
-      prev = w;
-      prev_h = h;
+      if (prev_h == eo.n_harmonics) {
+        how = "harmonic stepping";
+        return prev;
+      }
     }
-    if (prev_h == eo.n_harmonics) {
-      start = prev;
-      started = true;
-      ctx.report.section("frf")["start"] = "harmonic stepping";
-    }
-  }
-  if (!started) {
-    start = equations.stuck_solution(ao.lambda_start);
-    const continuation::Branch h = equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start);
-    ctx.report.section("frf")["start_homotopy_points"] = h.points.size();
+    how = "excitation homotopy";
+    start = equations.stuck_solution(f);
+    const continuation::Branch h = equations.solve_by_excitation_homotopy(f, ao, start);
     if (h.status != continuation::BranchStatus::kReachedEnd)
-      throw NumericalError("no solution at the start frequency " + io::format_number(ao.lambda_start) +
+      throw NumericalError("no solution at the start frequency " + io::format_number(f) +
                            " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
                            h.message);
     log::info("frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) + " points)");
-  }
-  const continuation::Branch branch = continuation::trace(equations, start, ao,
-                                                          [&](const continuation::BranchPoint& p) {
+    return start;
+  };
+  std::string how;
+  const Eigen::VectorXd start = start_at(ao.lambda_start, how);
+  ctx.report.section("frf")["start"] = how;
+  int piece = 0;
+  std::vector<int> pieces;
+  auto on_point = [&](const continuation::BranchPoint& p) {
     results.push_back(equations.analyse(p.x, p.lambda));
     iterations.push_back(p.newton_iterations);
+    pieces.push_back(piece);
     if (log::verbose()) {
       std::ostringstream s;
       s << "frf: point " << results.size() << "  f = " << std::fixed << std::setprecision(3) << p.lambda
@@ -185,22 +191,75 @@ int cmd_frf(Context& ctx) {
         << " m  step " << std::defaultfloat << std::setprecision(3) << p.step << "  newton " << p.newton_iterations;
       log::info(s.str());
     }
-  });
+  };
+  continuation::Branch branch = continuation::trace(equations, start, ao, on_point);
+  std::vector<continuation::BranchPoint> points = branch.points;
+  std::vector<int> point_piece(points.size(), 0);
+  // A branch that cannot reach the end of the range (it turned back through its start, e.g.
+  // along the twin of a branch that a sampled stick-slip state splits, or stalled at a corner)
+  // is completed from the other end: a second branch traced backwards from frequency_end_hz
+  // until it overlaps the first. The two pieces are listed one after the other (`piece`).
+  const double direction = ao.lambda_end > ao.lambda_start ? 1.0 : -1.0;
+  double reached = ao.lambda_start;
+  for (const auto& p : branch.points) reached = direction > 0 ? std::max(reached, p.lambda) : std::min(reached, p.lambda);
+  std::string first_message;
+  if (branch.status != continuation::BranchStatus::kReachedEnd && branch.status != continuation::BranchStatus::kStartFailed &&
+      branch.status != continuation::BranchStatus::kMaxPoints) {
+    first_message = branch.message;
+    log::info("frf: the branch from " + io::format_number(ao.lambda_start) + " Hz stopped (" + branch.message +
+              ") having reached " + io::format_number(reached) + " Hz; tracing back from " +
+              io::format_number(ao.lambda_end) + " Hz");
+    continuation::ArclengthOptions back = ao;
+    back.lambda_start = ao.lambda_end;
+    // Overlap the first piece by a few initial steps (within the range).
+    const double overlap = 4.0 * ao.initial_step * ao.lambda_scale;
+    back.lambda_end = direction > 0 ? std::max(ao.lambda_start, reached - overlap) : std::min(ao.lambda_start, reached + overlap);
+    back.max_points = std::max(1, ao.max_points - static_cast<int>(points.size()));
+    piece = 1;
+    try {
+      std::string back_how;
+      const Eigen::VectorXd back_start = start_at(back.lambda_start, back_how);
+      ctx.report.section("frf")["start_second_piece"] = back_how;
+      const continuation::Branch second = continuation::trace(equations, back_start, back, on_point);
+      points.insert(points.end(), second.points.begin(), second.points.end());
+      point_piece.resize(points.size(), 1);
+      branch.turning_points += second.turning_points;
+      branch.newton_iterations += second.newton_iterations;
+      branch.rejected_steps += second.rejected_steps;
+      branch.rejected_turns += second.rejected_turns;
+      branch.kinks_crossed += second.kinks_crossed;
+      branch.residual_evaluations += second.residual_evaluations;
+      if (second.status == continuation::BranchStatus::kReachedEnd) {
+        branch.status = continuation::BranchStatus::kReachedEnd;
+        branch.message = "";
+        ctx.report.warn("the curve is in two pieces: the branch from " + io::format_number(ao.lambda_start) +
+                        " Hz stopped at " + io::format_number(reached) + " Hz (" + first_message +
+                        "); the rest was traced back from " + io::format_number(ao.lambda_end) +
+                        " Hz (frf.csv column `piece`)");
+      } else {
+        branch.message = first_message + "; tracing back from " + io::format_number(ao.lambda_end) +
+                         " Hz stopped too: " + second.message;
+      }
+    } catch (const NumericalError& e) {
+      branch.message = first_message + "; no start point at the end of the range either: " + e.what();
+    }
+  }
   // Points dropped when a turning point was retraced are removed from the results as well.
   std::vector<forced::PointResult> kept;
-  std::vector<int> kept_it;
-  for (const auto& p : branch.points)
+  std::vector<int> kept_it, kept_piece;
+  for (std::size_t k = 0; k < points.size(); ++k)
     for (std::size_t i = results.size(); i-- > 0;)
-      if (results[i].frequency_hz == p.lambda) {
+      if (results[i].frequency_hz == points[k].lambda && pieces[i] == point_piece[k]) {
         kept.push_back(results[i]);
-        kept_it.push_back(p.newton_iterations);
+        kept_it.push_back(points[k].newton_iterations);
+        kept_piece.push_back(point_piece[k]);
         break;
       }
 
   std::ostringstream csv;
   csv << "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations";
   for (int n = 0; n <= c.hbm.harmonics; ++n) csv << ",h" << n << "_m";
-  csv << "\n";
+  csv << ",piece\n";
   double max_energy_error = 0.0, peak = 0.0, peak_f = 0.0;
   std::size_t peak_index = 0;
   int unconverged = 0;
@@ -209,7 +268,7 @@ int cmd_frf(Context& ctx) {
     csv << io::format_number(r.frequency_hz) << "," << io::format_number(r.amplitude) << ","
         << io::format_number(r.linear_amplitude) << "," << kept_it[i];
     for (double a : r.harmonic_amplitudes) csv << "," << io::format_number(a);
-    csv << "\n";
+    csv << "," << kept_piece[i] << "\n";
     max_energy_error = std::max(max_energy_error, r.energy_error);
     unconverged += r.unconverged_pairs;
     if (r.amplitude > peak) peak = r.amplitude, peak_f = r.frequency_hz, peak_index = i;
@@ -217,10 +276,10 @@ int cmd_frf(Context& ctx) {
   io::write_file_atomic(ctx.out_dir / "frf.csv", csv.str());
 
   // Hysteresis loops of every pair (at most 10) at the peak.
-  if (!branch.points.empty()) {
+  if (!points.empty()) {
     std::ostringstream loops;
     loops << "pair,sample,x_m,y_m,z_m,tx_n,ty_n,n_n\n";
-    const Eigen::VectorXd& w = branch.points[peak_index].x;
+    const Eigen::VectorXd& w = points[peak_index].x;
     const int block = evaluator.pair_layout().size();
     for (int p = 0; p < std::min(evaluator.n_pairs(), 10); ++p) {
       hbm::PairDetail d;
@@ -237,11 +296,14 @@ int cmd_frf(Context& ctx) {
 
   auto& j = ctx.report.section("frf");
   j["points"] = kept.size();
+  j["pieces"] = kept_piece.empty() ? 0 : kept_piece.back() + 1;
   j["status"] = continuation::to_string(branch.status);
   j["message"] = branch.message;
   j["turning_points"] = branch.turning_points;
   j["newton_iterations"] = branch.newton_iterations;
   j["rejected_steps"] = branch.rejected_steps;
+  j["rejected_turns"] = branch.rejected_turns;
+  j["kinks_crossed"] = branch.kinks_crossed;
   j["residual_evaluations"] = branch.residual_evaluations;
   j["unknowns"] = equations.size();
   j["contact_pairs"] = evaluator.n_pairs();

@@ -1,6 +1,7 @@
 // The mesh stage: a user's mesh read and checked, or the built-in sector generated
 // (and reused while its geometry is unchanged).
 #include <fstream>
+#include <mutex>
 #include <sstream>
 
 #include "app/context.hpp"
@@ -54,6 +55,10 @@ mesh::Mesh obtain_mesh(Context& ctx) {
   const io::Case& c = ctx.config;
   if (c.structure.type != "sector")
     throw InputError(c.file.string() + ": structure.type = \"" + c.structure.type + "\" has no mesh (meshes are for structure.type = \"sector\")");
+  // gmsh is one global session per process, and study points sharing a case name share its
+  // mesh file: one mesh stage at a time (generation, key and read stay consistent).
+  static std::mutex mesh_stage_mutex;
+  const std::lock_guard<std::mutex> lock(mesh_stage_mutex);
   log::Stopwatch clock;
   if (!c.structure.mesh.empty()) {
     mesh::Mesh m;

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 namespace shroudsim::continuation {
@@ -31,6 +32,8 @@ bool ArclengthOptions::validate(std::vector<std::string>* errors) const {
   if (!(initial_step > 0)) e.push_back("initial_step > 0");
   if (!(min_step > 0 && min_step < 1)) e.push_back("0 < min_step < 1");
   if (!(max_step >= 1)) e.push_back("max_step >= 1");
+  if (!(max_turn_deg > 0 && max_turn_deg < 180)) e.push_back("0 < max_turn_deg < 180");
+  if (!(kink_step > 0 && kink_step <= 1)) e.push_back("0 < kink_step <= 1");
   if (!(max_points >= 1)) e.push_back("max_points >= 1");
   if (!(tolerance > 0)) e.push_back("tolerance > 0");
   if (!(lambda_scale > 0)) e.push_back("lambda_scale > 0");
@@ -120,13 +123,31 @@ bool tangent_at(Scaled& s, const Eigen::VectorXd& y, const Eigen::VectorXd& row,
 int corrector(Scaled& s, Eigen::VectorXd& y, const Eigen::VectorXd& t, const Eigen::VectorXd& y_pred,
               const ArclengthOptions& o, double& final_norm) {
   const int n = s.n();
-  Eigen::VectorXd rs, b(n + 1), d;
+  Eigen::VectorXd rs, b(n + 1), d, y_prev, rs_try;
   Eigen::MatrixXd Js, A(n + 1, n + 1);
-  double first = -1.0;
+  double first = -1.0, prev_norm = 0.0;
+  auto norm_at = [&](const Eigen::VectorXd& yy, const Eigen::VectorXd& r) {
+    return std::max(r.lpNorm<Eigen::Infinity>(), std::abs(t.dot(yy - y_pred)));
+  };
   for (int it = 0; it <= o.max_newton_iterations; ++it) {
     if (!s.evaluate(y, rs, &Js)) return -1;
+    double norm = norm_at(y, rs);
+    // A full step that did not reduce the residual (Newton cycling between the pieces of a
+    // nonsmooth residual, e.g. a sample switching between stick and slip) is cut back along
+    // its direction, by halves, to the first point that does; failing that, it is kept.
+    if (it > 0 && norm >= prev_norm) {
+      for (double a = 0.5; a >= 1.0 / 16.0; a *= 0.5) {
+        const Eigen::VectorXd y_try = y_prev + a * d;
+        if (!s.evaluate(y_try, rs_try, nullptr)) break;
+        if (norm_at(y_try, rs_try) < prev_norm) {
+          y = y_try;
+          if (!s.evaluate(y, rs, &Js)) return -1;
+          norm = norm_at(y, rs);
+          break;
+        }
+      }
+    }
     const double constraint = t.dot(y - y_pred);
-    const double norm = std::max(rs.lpNorm<Eigen::Infinity>(), std::abs(constraint));
     if (first < 0) first = norm;
     final_norm = norm;
     if (norm <= o.tolerance) return it;
@@ -136,9 +157,50 @@ int corrector(Scaled& s, Eigen::VectorXd& y, const Eigen::VectorXd& t, const Eig
     b.head(n) = -rs;
     b[n] = -constraint;
     if (!s.residual().solve_augmented(A, b, d)) return -1;
+    y_prev = y;
+    prev_norm = norm;
     y += d;
   }
   return -1;
+}
+
+/// At a corner of a piecewise-smooth branch (a nonsmooth residual: the hyperplane normal to the
+/// tangent t no longer meets the branch near y), the next piece is sought along the null vector
+/// of the Jacobian a little beyond the corner (the residual's other piece), in both
+/// orientations, at a few step sizes from `kink`, and then along t itself with larger steps
+/// (over the corner). A solution that heads back (tangent within ~25 degrees of -t: the branch
+/// already traced, or its twin through a sample that switches state, which a time-discretized
+/// friction law produces near incipient slip) does not count. On success y_new is the new point
+/// and t_new its tangent, oriented away from y.
+bool cross_kink(Scaled& s, const Eigen::VectorXd& y, const Eigen::VectorXd& t, double kink, const ArclengthOptions& o,
+                Eigen::VectorXd& y_new, Eigen::VectorXd& t_new, int& iterations, double& rnorm) {
+  std::vector<Eigen::VectorXd> directions;
+  for (double beyond : {0.1, 1.0, 10.0}) {
+    Eigen::VectorXd tb;
+    if (!tangent_at(s, y + beyond * kink * t, t, t, tb)) continue;
+    directions.push_back(tb);
+    directions.push_back(-tb);
+  }
+  std::vector<std::pair<Eigen::VectorXd, double>> trials;
+  for (const Eigen::VectorXd& v : directions)
+    for (double size : {1.0, 10.0, 100.0}) trials.emplace_back(v, size);
+  for (double size : {10.0, 100.0, 1000.0}) trials.emplace_back(t, size);
+  for (const auto& [v, size] : trials) {
+    const Eigen::VectorXd y_pred = y + size * kink * v;
+    Eigen::VectorXd yc = y_pred;
+    const int it = corrector(s, yc, v, y_pred, o, rnorm);
+    if (it < 0) continue;
+    Eigen::VectorXd d = yc - y;
+    const double moved = d.norm();
+    if (moved < 0.1 * size * kink) continue;
+    d /= moved;
+    if (d.dot(-t) > 0.9) continue;  // back along the branch already traced
+    if (!tangent_at(s, yc, d, d, t_new) || t_new.dot(-t) > 0.9) continue;
+    y_new = yc;
+    iterations = it;
+    return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -203,7 +265,9 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
 
   double step = o.initial_step;
   const double min_step = o.min_step * o.initial_step, max_step = o.max_step * o.initial_step;
-  bool retracing = false;
+  const double kink_step = o.kink_step * o.initial_step;
+  const double cos_max_turn = std::cos(o.max_turn_deg * std::numbers::pi / 180.0);
+  bool retracing = false, kink_tried = false;
   int retraced_points = 0;
   std::vector<Eigen::VectorXd> tangents = {t};  // tangent of each accepted point, for backtracking
 
@@ -214,6 +278,22 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
     it = corrector(s, y_new, t, y_pred, o, rnorm);
     Eigen::VectorXd t_new;
     if (it >= 0 && !tangent_at(s, y_new, t, t, t_new)) it = -1;
+    // Branch jump: the tangent turned too far over one step. Rejected unless the step is
+    // already at kink size.
+    if (it >= 0 && step > kink_step && t_new.dot(t) < cos_max_turn) {
+      ++branch.rejected_turns;
+      it = -1;
+    }
+    if (it < 0 && step < kink_step && !kink_tried) {
+      // The step has shrunk to kink size without a solution: a corner of a nonsmooth branch.
+      kink_tried = true;
+      if (cross_kink(s, y, t, kink_step, o, y_new, t_new, it, rnorm)) {
+        ++branch.kinks_crossed;
+        step = (y_new - y).norm();
+      } else {
+        it = -1;
+      }
+    }
     if (it < 0) {
       ++branch.rejected_steps;
       step *= 0.5;
@@ -228,10 +308,12 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
       continue;
     }
     branch.newton_iterations += it;
+    kink_tried = false;
 
     // Turning point: the lambda component of the tangent changes sign.
     if (t_new[n] * t[n] < 0.0) {
-      if (!retracing && static_cast<int>(branch.points.size()) > 1) {
+      const bool resolved = std::abs(y_new[n] - y[n]) < 0.1 * o.initial_step;
+      if (!retracing && !resolved && static_cast<int>(branch.points.size()) > 1) {
         const int drop = std::min<int>(o.turning_backtrack, static_cast<int>(branch.points.size()) - 1);
         for (int k = 0; k < drop; ++k) {
           branch.points.pop_back();

@@ -7,9 +7,18 @@
 //     R(x, lambda) = 0,   t_k . (y_s - y_p,s) = 0.
 // Step control: grow after few Newton iterations, shrink after many or on failure. When the
 // lambda component of the tangent changes sign (a turning point), the last `turning_backtrack`
-// points are dropped and the turn is retraced at a tenth of the step. When the x part of the
-// tangent grows by more than `steep_ratio` between two points (a steep branch), the step is
-// capped at the initial step.
+// points are dropped and the turn is retraced at a tenth of the step, unless the step already
+// moved lambda by less than a tenth of the initial step (a fold on a near-vertical stretch,
+// where a piecewise-smooth residual such as a friction law sampled in time zigzags by round-off
+// amounts: retracing there would only shrink the step without locating anything better). When
+// the x part of the tangent grows by more than `steep_ratio` between two points (a steep
+// branch), the step is capped at the initial step. A step whose tangent turns by more than
+// `max_turn_deg` is rejected and halved (it has most likely jumped to a nearby branch, or
+// cut a corner too sharp to follow); below
+// `kink_step` (relative to initial_step) it is accepted all the same, so that a true kink
+// of a nonsmooth residual does not stop the branch. When even a kink-size step finds no
+// solution (a corner sharper than a right angle: the branch goes on along the residual's other
+// piece), the null vector of the Jacobian just beyond the corner is tried, both ways.
 //
 // Usage:
 //   MyResidual r;                        // implements ParametricResidual
@@ -55,6 +64,8 @@ struct ArclengthOptions {
   int target_newton_iterations = 4;  ///< grow the step below, shrink above
   double steep_ratio = 30.0;      ///< "a" of the steep-branch rule (20 to 40)
   int turning_backtrack = 2;      ///< points dropped before retracing a turning point
+  double max_turn_deg = 30.0;     ///< largest angle between successive tangents (scaled)
+  double kink_step = 1e-3;        ///< relative to initial_step: below, large turns are accepted
   /// How far beyond lambda_start (against the direction of travel, in lambda units) the
   /// branch may go before it counts as having left the range (0: not at all).
   double start_slack = 0.0;
@@ -82,6 +93,8 @@ struct Branch {
   int turning_points = 0;           ///< folds passed (after retracing)
   int newton_iterations = 0;        ///< total
   int rejected_steps = 0;           ///< corrector failures that shrank the step
+  int rejected_turns = 0;           ///< of those, steps whose tangent turned too far (branch jumps)
+  int kinks_crossed = 0;            ///< corners of a nonsmooth branch passed along the other piece
   int residual_evaluations = 0;
 };
 

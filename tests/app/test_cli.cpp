@@ -177,7 +177,7 @@ TEST(Cli, FrfWritesTheContractColumnsAndNoNaN) {
   ASSERT_EQ(r.status, 0) << r.err;
   const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "frf.csv"));
   ASSERT_GT(lines.size(), 20u);
-  EXPECT_EQ(lines[0], "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations,h0_m,h1_m,h2_m,h3_m");
+  EXPECT_EQ(lines[0], "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations,h0_m,h1_m,h2_m,h3_m,piece");
   for (const auto& l : lines) {
     EXPECT_EQ(l.find("nan"), std::string::npos) << l;
     EXPECT_EQ(l.find("inf"), std::string::npos) << l;

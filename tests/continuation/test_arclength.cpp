@@ -127,6 +127,8 @@ TEST(Arclength, ReportsFailuresInsteadOfHidingThem) {
   Duffing duffing(0.01, 1.0, 0.01);
   o.lambda_start = 0.5;
   o.lambda_end = 1.5;
+  o.x_scale = Eigen::VectorXd::Constant(2, 0.05);  // the scaling of the traced curves above
+  o.initial_step = 0.02;
   o.max_points = 7;
   const Branch capped = trace(duffing, Eigen::VectorXd::Zero(2), o);
   EXPECT_EQ(capped.status, BranchStatus::kMaxPoints);

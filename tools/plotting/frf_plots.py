@@ -20,12 +20,25 @@ def plot_frf(result_dir):
     f = [float(r["frequency_hz"]) for r in rows]
     a = [float(r["amplitude_m"]) for r in rows]
     lin = [float(r["linear_amplitude_m"]) for r in rows]
+    # A curve traced in two pieces (forward, then back from the end: column `piece`) is drawn
+    # piece by piece, so that no line joins the end of one to the start of the other.
+    piece = [int(r.get("piece", 0) or 0) for r in rows]
+    runs = []
+    for i, p in enumerate(piece):
+        if i == 0 or p != piece[i - 1]:
+            runs.append([])
+        runs[-1].append(i)
     fig, ax = plt.subplots(figsize=(8, 5))
-    ax.semilogy(f, lin, color="0.6", lw=1, label="linear, contact open")
-    ax.semilogy(f, a, color="C0", lw=1.5, label="nonlinear (friction contact)")
     harmonics = [k for k in rows[0] if k.startswith("h") and k.endswith("_m")]
-    for k in harmonics[2:]:  # h0 is the static part, h1 dominates; show the higher ones
-        ax.semilogy(f, [max(float(r[k]), 1e-30) for r in rows], lw=0.7, ls="--", label=k[:-2])
+    for n, run in enumerate(runs):
+        fr = [f[i] for i in run]
+        first = n == 0
+        ax.semilogy(fr, [lin[i] for i in run], color="0.6", lw=1, label="linear, contact open" if first else None)
+        ax.semilogy(fr, [a[i] for i in run], color="C0", lw=1.5,
+                    label=("nonlinear (friction contact)" + (f", {len(runs)} pieces" if len(runs) > 1 else "")) if first else None)
+        for c, k in enumerate(harmonics[2:]):  # h0 is the static part, h1 dominates; show the higher ones
+            ax.semilogy(fr, [max(float(rows[i][k]), 1e-30) for i in run], lw=0.7, ls="--", color=f"C{c + 1}",
+                        label=k[:-2] if first else None)
     i = max(range(len(a)), key=lambda j: a[j])
     ax.plot([f[i]], [a[i]], "o", color="C3", label=f"peak {a[i]:.3g} m at {f[i]:.2f} Hz")
     ax.set_xlabel("excitation frequency [Hz]")
