@@ -1,13 +1,32 @@
 // `shroudsim campbell`: natural frequencies against speed with engine-order lines ->
 // campbell.csv, crossings.csv (and modes.csv, campbell.png, nd_map.png).
 //
-// Frequencies do not depend on speed yet (no centrifugal stiffening or spin softening).
+// Speeds: campbell.speed_points values evenly spaced over campbell.speed_rpm = [s0, s1].
+// - rotating_effects = false: the frequencies at rest at every speed (flat lines).
+// - rotating_effects = true: at each speed Omega [rad/s] = 2 pi rpm / 60, the modes of
+//     (K_h + Omega^2 D_h) phi = w^2 M_h phi,  D_h = T_h^H (K_sigma1 - M_spin) T_h,
+//   K_sigma1 the geometric stiffness of the centrifugal prestress at unit Omega^2 (linear
+//   static solve of the clamped sector in harmonic index 0: body force rho Omega^2 (x, y, 0),
+//   axis = global z), M_spin the mass on the in-plane components (spin softening); Coriolis
+//   is neglected (modal/rotating.hpp, fe/rotating.hpp). The prestress is computed once
+//   (stress scales with Omega^2); per harmonic index the pattern of K_h + D_h is analyzed
+//   once and each speed refactorizes numerically. Harmonic indices run in parallel
+//   (--threads); h and Nb - h share one sweep. Speed 0 reuses the modes at rest.
+// Modes are numbered by frequency at each speed (mode r = the r-th lowest), so where two
+// families cross in frequency the numbering swaps.
+//
 // Engine order e excites harmonic index h = e mod Nb, so it meets the modes of nodal
 // diameter min(h, Nb - h) (aliasing included: with Nb = 8, EO 9 excites ND 1, EO 6 ND 2).
-// A crossing is where the line f = e * rpm / 60 meets a mode's frequency f_r:
-// rpm = 60 f_r / e, listed when inside [speed_rpm[0], speed_rpm[1]].
+// A crossing is where g_r(s) = f_r(s) - e s / 60 changes sign between two speed points
+// (or is zero at one): s by linear interpolation of g between them, f = e s / 60 (on the
+// line). For flat lines this is exactly rpm = 60 f_r / e.
 #include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <map>
+#include <mutex>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "app/context.hpp"
@@ -15,8 +34,30 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
+#include "modal/rotating.hpp"
 
 namespace shroudsim::app {
+namespace {
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+// Frequencies [Hz] of one canonical harmonic index at every speed point (empty: not solved).
+struct Sweep {
+  std::vector<Eigen::VectorXd> f;
+  std::string failure;      // first failure of the sweep (the later speeds are skipped)
+  double seconds = 0.0;     // solves only
+  double factor_seconds = 0.0, lanczos_seconds = 0.0;
+  int solves = 0;
+  int analyses = 0;
+};
+
+}  // namespace
 
 int cmd_campbell(Context& ctx) {
   const io::Case& c = ctx.config;
@@ -27,10 +68,6 @@ int cmd_campbell(Context& ctx) {
   if (c.structure.type != "sector")
     throw InputError(where("structure.type") + ": structure.type = \"" + c.structure.type +
                      "\": `campbell` needs an FE sector (structure.type = \"sector\")");
-  if (c.campbell.rotating_effects)
-    throw InputError(where("campbell.rotating_effects") +
-                     ": campbell.rotating_effects = true is not supported yet (frequencies are "
-                     "speed-independent); set it to false");
   if (c.campbell.speed_rpm.size() != 2 || !(c.campbell.speed_rpm[0] >= 0.0) ||
       !(c.campbell.speed_rpm[1] > c.campbell.speed_rpm[0]))
     throw InputError(where("campbell.speed_rpm") + ": campbell.speed_rpm violates: [min, max] with 0 <= min < max");
@@ -55,47 +92,190 @@ int cmd_campbell(Context& ctx) {
 
   const double s0 = c.campbell.speed_rpm[0], s1 = c.campbell.speed_rpm[1];
   const int np = c.campbell.speed_points;
+  std::vector<double> rpm(np);
+  for (int i = 0; i < np; ++i) rpm[i] = s0 + (s1 - s0) * i / (np - 1);
+  const bool rotating = c.campbell.rotating_effects;
+  auto& report = ctx.report.section("campbell");
+  report["rotating_effects"] = rotating;
+  report["speed_points"] = np;
+
+  // Canonical harmonic indices (h and Nb - h share frequencies) that have modes at rest.
+  std::vector<int> canonical;
+  for (const auto& [h, b] : model.bases) canonical.push_back(std::min(h, (nb - h) % nb));
+  std::sort(canonical.begin(), canonical.end());
+  canonical.erase(std::unique(canonical.begin(), canonical.end()), canonical.end());
+  std::map<int, Sweep> sweeps;
+  for (int h : canonical) sweeps[h].f.assign(np, Eigen::VectorXd());
+
+  if (!rotating) {
+    for (int h : canonical)
+      for (int i = 0; i < np; ++i) sweeps[h].f[i] = model.bases.at(h).frequency_hz();
+  } else {
+    // Centrifugal prestress (h = 0 static solve) and the reduction of K_sigma1, M_spin.
+    log::Stopwatch watch;
+    const cyclic::CyclicSector& sector = model.cyclic();
+    const modal::RotatingOperators ops = modal::rotating_operators(model.mesh, model.material, model.km, sector);
+    const cyclic::CyclicSector rot(model.mesh, {ops.geometric, ops.spin});
+    const double prestress_seconds = watch.seconds();
+    const double omega_top = modal::rpm_to_rad_s(s1);
+    const double peak_top = ops.peak.von_mises * omega_top * omega_top;
+    const double tip_top = ops.displacement.cwiseAbs().maxCoeff() * omega_top * omega_top;
+    report["prestress_seconds"] = prestress_seconds;
+    report["peak_von_mises_pa_at_top_speed"] = peak_top;
+    report["peak_von_mises_element"] = ops.peak.element;
+    report["max_static_displacement_m_at_top_speed"] = tip_top;
+    log::info("campbell: centrifugal prestress at " + io::format_number(s1) + " rpm: peak von Mises " +
+              fixed(peak_top / 1e6, 1) + " MPa (element " + std::to_string(ops.peak.element) +
+              "), largest displacement " + fixed(tip_top * 1e3, 3) + " mm (" + fixed(prestress_seconds, 2) + " s)");
+
+    const int workers = std::clamp(ctx.threads > 0 ? ctx.threads : static_cast<int>(std::thread::hardware_concurrency()),
+                                   1, static_cast<int>(canonical.size()));
+    std::atomic<std::size_t> next{0};
+    std::mutex lock;
+    auto work = [&] {
+      for (std::size_t k = next++; k < canonical.size(); k = next++) {
+        const int h = canonical[k];
+        Sweep s;
+        s.f.assign(np, Eigen::VectorXd());
+        try {
+          modal::RotatingHarmonic hr(sector, rot, h);
+          for (int i = 0; i < np; ++i) {
+            if (rpm[i] == 0.0) {  // K(0) = K: the modes at rest
+              s.f[i] = model.bases.at(h).frequency_hz();
+              continue;
+            }
+            log::Stopwatch solve_clock;
+            const modal::ModalResult r = hr.solve(modal::rpm_to_rad_s(rpm[i]), model.options);
+            s.seconds += solve_clock.seconds();
+            s.factor_seconds += r.report.factor_seconds;
+            s.lanczos_seconds += r.report.solve_seconds;
+            ++s.solves;
+            if (!r.report.ok()) {
+              s.failure = "harmonic index " + std::to_string(h) + " at " + io::format_number(rpm[i]) +
+                          " rpm: " + modal::to_string(r.report.status) + ": " + r.report.message +
+                          (r.report.status == modal::ModalStatus::FactorizationFailed
+                               ? " (K + K_sigma - Omega^2 M_spin is not positive definite: a mode diverges)"
+                               : "");
+              // Where: the lowest f^2 extrapolated linearly in Omega^2 to zero from the last two speeds.
+              if (i >= 2 && s.f[i - 1].size() > 0 && s.f[i - 2].size() > 0) {
+                const double fa = s.f[i - 2](0), fb = s.f[i - 1](0);
+                const double wa = rpm[i - 2] * rpm[i - 2], wb = rpm[i - 1] * rpm[i - 1];
+                s.failure += "; mode 1 is " + fixed(fb, 1) + " Hz at " + io::format_number(rpm[i - 1]) + " rpm";
+                if (fb < fa)
+                  s.failure += ", extrapolated to 0 Hz near " +
+                               fixed(std::sqrt(wb + (0.0 - fb * fb) * (wb - wa) / (fb * fb - fa * fa)), 0) + " rpm";
+              }
+              break;
+            }
+            s.f[i] = r.basis.frequency_hz();
+          }
+          s.analyses = hr.reuse().analyses;
+        } catch (const std::exception& e) {
+          s.failure = "harmonic index " + std::to_string(h) + ": " + e.what();
+        }
+        std::string line = "campbell h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
+        if (s.f.front().size() > 0 && s.f.back().size() > 0)
+          line += "mode 1 " + fixed(s.f.front()(0), 2) + " Hz at " + io::format_number(s0) + " rpm -> " +
+                  fixed(s.f.back()(0), 2) + " Hz at " + io::format_number(s1) + " rpm, ";
+        line += std::to_string(s.solves) + " speeds in " + fixed(s.seconds, 2) + " s (" +
+                fixed(s.solves ? s.seconds / s.solves : 0.0, 3) + " s each, " + std::to_string(s.analyses) +
+                " symbolic analysis)";
+        if (!s.failure.empty()) line += "; FAILED: " + s.failure;
+        log::info(line);
+        std::lock_guard<std::mutex> g(lock);
+        sweeps[h] = std::move(s);
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < workers; ++t) pool.emplace_back(work);
+    work();
+    for (auto& t : pool) t.join();
+
+    nlohmann::json per_h = nlohmann::json::array();
+    double total = 0.0;
+    int solves = 0;
+    for (int h : canonical) {
+      const Sweep& s = sweeps.at(h);
+      total += s.seconds;
+      solves += s.solves;
+      nlohmann::json entry = {{"harmonic_index", h}, {"solves", s.solves}, {"seconds", s.seconds},
+                              {"factor_seconds", s.factor_seconds}, {"lanczos_seconds", s.lanczos_seconds},
+                              {"symbolic_analyses", s.analyses}};
+      if (!s.failure.empty()) entry["failure"] = s.failure;
+      if (s.f.front().size() > 0 && s.f.back().size() > 0)
+        entry["mode1_hz"] = {s.f.front()(0), s.f.back()(0)};
+      per_h.push_back(entry);
+      if (!s.failure.empty()) model.failures.push_back(s.failure);
+    }
+    report["sweeps"] = per_h;
+    report["solves"] = solves;
+    report["solve_seconds"] = total;
+    report["seconds_per_speed_point"] = total / std::max(1, np - (rpm[0] == 0.0 ? 1 : 0));
+  }
+
+  // campbell.csv: every speed, every harmonic index asked for (Nb - h from h).
   std::ostringstream camp;
   camp << "speed_rpm,harmonic_index,nodal_diameter,mode,frequency_hz\n";
   for (int i = 0; i < np; ++i) {
-    const double rpm = s0 + (s1 - s0) * i / (np - 1);
     for (const auto& [h, b] : model.bases) {
-      const Eigen::VectorXd f = b.frequency_hz();
-      for (int r = 0; r < b.size(); ++r)
-        camp << io::format_number(rpm) << ',' << h << ',' << cyclic::nodal_diameter(h, nb) << ',' << r + 1 << ','
+      const Eigen::VectorXd& f = sweeps.at(std::min(h, (nb - h) % nb)).f[i];
+      for (Eigen::Index r = 0; r < f.size(); ++r)
+        camp << io::format_number(rpm[i]) << ',' << h << ',' << cyclic::nodal_diameter(h, nb) << ',' << r + 1 << ','
              << io::format_number(f(r)) << '\n';
     }
   }
   io::write_file_atomic(ctx.out_dir / "campbell.csv", camp.str());
 
+  // Crossings: sign changes of g = f_r(s) - e s / 60 between speed points.
   std::vector<std::tuple<int, double, int, int, double>> rows;  // eo, rpm, nd, mode, f
   for (int e : c.campbell.engine_orders) {
     const int h = e % nb;
-    auto it = model.bases.find(h);
-    if (it == model.bases.end()) continue;  // its solve failed: reported below
-    const Eigen::VectorXd f = it->second.frequency_hz();
-    for (int r = 0; r < f.size(); ++r) {
-      const double rpm = 60.0 * f(r) / e;
-      if (rpm >= s0 && rpm <= s1) rows.emplace_back(e, rpm, cyclic::nodal_diameter(h, nb), r + 1, f(r));
+    if (!model.bases.count(h)) continue;  // its solve failed: reported below
+    const Sweep& s = sweeps.at(std::min(h, (nb - h) % nb));
+    int last = np - 1;  // a failed sweep: speeds up to the first missing one
+    for (int i = 0; i < np; ++i)
+      if (s.f[i].size() == 0) {
+        last = i - 1;
+        break;
+      }
+    if (last < 0) continue;
+    const Eigen::Index n_modes = s.f[0].size();
+    for (Eigen::Index r = 0; r < n_modes; ++r) {
+      auto g = [&](int i) { return s.f[i](r) - e * rpm[i] / 60.0; };
+      for (int i = 0; i <= last; ++i) {
+        if (s.f[i].size() <= r) break;
+        const double gi = g(i);
+        if (gi == 0.0) {
+          rows.emplace_back(e, rpm[i], cyclic::nodal_diameter(h, nb), static_cast<int>(r) + 1, s.f[i](r));
+          continue;
+        }
+        if (i == last || s.f[i + 1].size() <= r) break;
+        const double gj = g(i + 1);
+        if (gj == 0.0 || (gi > 0.0) == (gj > 0.0)) continue;
+        const double t = gi / (gi - gj);
+        const double at = rpm[i] + t * (rpm[i + 1] - rpm[i]);
+        rows.emplace_back(e, at, cyclic::nodal_diameter(h, nb), static_cast<int>(r) + 1, e * at / 60.0);
+      }
     }
   }
   std::sort(rows.begin(), rows.end());
   std::ostringstream cross;
   cross << "engine_order,nodal_diameter,mode,speed_rpm,frequency_hz\n";
-  for (const auto& [e, rpm, nd, r, f] : rows)
-    cross << e << ',' << nd << ',' << r << ',' << io::format_number(rpm) << ',' << io::format_number(f) << '\n';
+  for (const auto& [e, at, nd, r, f] : rows)
+    cross << e << ',' << nd << ',' << r << ',' << io::format_number(at) << ',' << io::format_number(f) << '\n';
   io::write_file_atomic(ctx.out_dir / "crossings.csv", cross.str());
   ctx.report.stage("campbell", clock.seconds(), false);
-  ctx.report.section("campbell")["crossings"] = rows.size();
+  report["crossings"] = rows.size();
   log::info("campbell: " + std::to_string(rows.size()) + " crossings of engine orders with modes in [" +
-            io::format_number(s0) + ", " + io::format_number(s1) + "] rpm");
+            io::format_number(s0) + ", " + io::format_number(s1) + "] rpm" +
+            (rotating ? " (rotating effects)" : " (frequencies at rest)"));
 
+  draw_plots(ctx);  // what converged is drawn even when a sweep failed
   if (!model.failures.empty()) {
     std::string msg = "modal analysis failed for";
     for (const auto& f : model.failures) msg += "\n  " + f;
-    throw NumericalError(msg + "\n(campbell.csv and crossings.csv hold the harmonic indices that converged)");
+    throw NumericalError(msg + "\n(campbell.csv and crossings.csv hold the harmonic indices and speeds that converged)");
   }
-  draw_plots(ctx);
   return 0;
 }
 

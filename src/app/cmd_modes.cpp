@@ -22,6 +22,7 @@
 #include "io/output.hpp"
 #include "modal/cache.hpp"
 #include "modal/harmonic.hpp"
+#include "modal/rotating.hpp"
 
 #ifndef SHROUDSIM_SOURCE_DIR
 #define SHROUDSIM_SOURCE_DIR "."
@@ -57,10 +58,17 @@ std::string matrices_key(const mesh::Mesh& m, const fe::Material& mat) {
   return h.hex();
 }
 
-std::string modes_key(const std::string& km_key, int h, const modal::ModalOptions& o) {
+// Speed 0 keeps the key of the modes at rest; a speed adds the rotating-effects tag and Omega.
+constexpr const char* kRotatingVersion = "rotating/1";
+
+std::string modes_key(const std::string& km_key, int h, const modal::ModalOptions& o, double speed_rpm) {
   fe::Hasher hs;
   hs.add(std::string(kModesVersion));
   hs.add(km_key);
+  if (speed_rpm > 0.0) {
+    hs.add(std::string(kRotatingVersion));
+    hs.add(speed_rpm);
+  }
   hs.add(h);
   hs.add(o.modes);
   hs.add(o.shift);
@@ -110,7 +118,8 @@ std::vector<int> modal_harmonic_indices(const io::Case& c) {
   return hs;
 }
 
-ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors) {
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors,
+                           double speed_rpm) {
   const io::Case& c = ctx.config;
   ModalModel model;
   model.mesh = obtain_mesh(ctx);
@@ -154,6 +163,26 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   log::info(std::string(km_reused ? "reused" : "assembled") + " K and M: " + std::to_string(model.mesh.n_dofs()) +
             " DOFs, " + std::to_string(model.km.K.nonZeros()) + " stored entries (" + fixed(km_seconds, 2) + " s)");
 
+  // Spinning sector: K -> K + Omega^2 (K_sigma1 - M_spin), prestress from the h = 0 static solve.
+  model.speed_rpm = speed_rpm;
+  if (speed_rpm > 0.0) {
+    clock.restart();
+    const double omega = modal::rpm_to_rad_s(speed_rpm);
+    const cyclic::CyclicSector rest(model.mesh, model.km);
+    const modal::RotatingOperators ops = modal::rotating_operators(model.mesh, model.material, model.km, rest);
+    model.km.K = model.km.K + (omega * omega) * ops.rotating_stiffness();
+    model.km.K.makeCompressed();
+    const double seconds = clock.seconds();
+    ctx.report.stage("prestress", seconds, false);
+    report["rotating"] = {{"speed_rpm", speed_rpm}, {"omega_rad_s", omega},
+                          {"peak_von_mises_pa", ops.peak.von_mises * omega * omega},
+                          {"max_static_displacement_m", ops.displacement.cwiseAbs().maxCoeff() * omega * omega},
+                          {"seconds", seconds}};
+    log::info("rotating at " + io::format_number(speed_rpm) + " rpm: centrifugal prestress (peak von Mises " +
+              fixed(ops.peak.von_mises * omega * omega / 1e6, 1) + " MPa), K + K_sigma - Omega^2 M_spin (" +
+              fixed(seconds, 2) + " s)");
+  }
+
   // Canonical harmonic indices: h and Nb - h share the solve of min(h, Nb - h).
   std::vector<int> canonical;
   for (int h : harmonic_indices) canonical.push_back(std::min(h, (nb - h) % nb));
@@ -164,7 +193,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   std::map<int, HarmonicOutcome> outcome;
   std::vector<int> to_solve;
   for (int h : canonical) {
-    const fs::path f = cache_dir / ("modes-" + modes_key(km_key, h, model.options) + ".bin");
+    const fs::path f = cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm) + ".bin");
     auto cached = modal::load_basis(f);
     if (cached && cached->harmonic_index == h && cached->size() == model.options.modes) {
       HarmonicOutcome& o = outcome[h];
@@ -238,13 +267,18 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     }
     per_h.push_back(entry);
     if (!r.ok()) {
-      model.failures.push_back("harmonic index " + std::to_string(h) + ": " + modal::to_string(r.status) + ": " + r.message);
+      std::string why = "harmonic index " + std::to_string(h) + ": " + modal::to_string(r.status) + ": " + r.message;
+      if (speed_rpm > 0.0 && r.status == modal::ModalStatus::FactorizationFailed)
+        why += " (at " + io::format_number(speed_rpm) +
+               " rpm K + K_sigma - Omega^2 M_spin is not positive definite: a mode diverges; see `campbell` with "
+               "rotating_effects = true)";
+      model.failures.push_back(why);
       continue;
     }
     if (!r.message.empty()) ctx.report.warn("harmonic index " + std::to_string(h) + ": " + r.message);
     if (!o.reused) {
       try {
-        modal::save_basis(cache_dir / ("modes-" + modes_key(km_key, h, model.options) + ".bin"), o.result.basis);
+        modal::save_basis(cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm) + ".bin"), o.result.basis);
       } catch (const std::exception& e) {
         ctx.report.warn(std::string("could not cache modes: ") + e.what());
       }

@@ -31,6 +31,7 @@ struct ModalModel {
   mesh::Mesh mesh;
   fe::Material material;
   modal::ModalOptions options;
+  double speed_rpm = 0.0;                     ///< > 0: K below is the rotating stiffness at this speed
   linalg::SparsePair<double> km;              ///< sector K [N/m], M [kg] on all 3 * n_nodes DOFs
   std::map<int, modal::ModalBasis> bases;     ///< per harmonic index (reduced DOFs of that h)
   std::map<int, modal::StiffnessFactor> factors;  ///< K_h factors kept from the solves (h with shift 0)
@@ -54,7 +55,13 @@ std::vector<int> modal_harmonic_indices(const io::Case& c);
 /// what converged and throws NumericalError). keep_factors: keep the K_h factorizations of
 /// the solves in ModalModel::factors (memory: about nnz(L) * 16 bytes each; a harmonic index
 /// read from the cache gets its factor on demand from stiffness_factor()).
-ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors = true);
+/// speed_rpm > 0: the sector spins at that speed (rad/s: Omega = 2 pi rpm / 60) and
+/// ModalModel::km.K becomes the rotating stiffness K + Omega^2 (K_sigma1 - M_spin)
+/// (centrifugal stiffening and spin softening, modal/rotating.hpp), so the modes, the
+/// cyclic reduction and the K_h factors (static and residual flexibility) are all those at
+/// that speed; the mode cache key then includes the speed. 0: the sector at rest.
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors = true,
+                           double speed_rpm = 0.0);
 
 /// modes.csv: harmonic_index,nodal_diameter,mode,frequency_hz (mode numbered from 1).
 void write_modes_csv(Context& ctx, const ModalModel& model);

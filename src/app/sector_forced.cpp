@@ -107,7 +107,8 @@ ForcedModel make_sector_model(Context& ctx) {
   const int nb = c.structure.sectors, m = c.excitation.engine_order;
   std::set<int> needed;
   for (int n = 1; n <= c.hbm.harmonics; ++n) needed.insert(((n * m) % nb + nb) % nb);
-  ModalModel modal = run_modal_stage(ctx, std::vector<int>(needed.begin(), needed.end()));
+  ModalModel modal = run_modal_stage(ctx, std::vector<int>(needed.begin(), needed.end()), /*keep_factors=*/true,
+                                     c.excitation.speed_rpm);  // > 0: the modes at that speed
   if (!modal.failures.empty()) throw NumericalError("modal stage failed: " + modal.failures.front());
   const mesh::Mesh& mesh = modal.mesh;
 

@@ -66,7 +66,7 @@ const std::vector<KeySpec>& case_schema() {
       {"excitation.point", "[0.0, 0.35, 0.0]", "3 numbers (m)", "sector: the force acts at the nearest node"},
       {"excitation.force", "[1.0, 1.0, 1.0]", "3 numbers (N, global x y z); lumped: one number", "force amplitude"},
       {"excitation.dof", "0", "0 <= dof < n (lumped only)", "lumped: the excited DOF"},
-      {"excitation.speed_rpm", "0.0", ">= 0", "rotor speed of the forced response (rpm)"},
+      {"excitation.speed_rpm", "0.0", ">= 0", "rotor speed of the forced response (rpm); > 0 uses the modes with centrifugal stiffening and spin softening at that speed"},
 
       {"response.point", "[0.0, 0.34, 0.0]", "3 numbers (m)", "sector: the response is read at the nearest node"},
       {"response.dof", "0", "0 <= dof < n (lumped only)", "lumped: the response DOF"},

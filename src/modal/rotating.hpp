@@ -50,6 +50,8 @@ struct RotatingOperators {
 RotatingOperators rotating_operators(const mesh::Mesh& mesh, const fe::Material& material,
                                      const linalg::SparsePair<double>& km, const std::vector<int>& fixed_dofs);
 /// A cyclic sector (`sector` built from the same km): the static solve in harmonic index 0.
+/// The shroud contact is open (as in the modes): a shroud overhang is loaded by its own
+/// centrifugal force only.
 RotatingOperators rotating_operators(const mesh::Mesh& mesh, const fe::Material& material,
                                      const linalg::SparsePair<double>& km, const cyclic::CyclicSector& sector);
 

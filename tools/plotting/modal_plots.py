@@ -98,7 +98,9 @@ def plot_campbell(result_dir):
     ax.set_ylim(0, f_top)
     ax.set_xlabel("speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
-    ax.set_title("Campbell diagram (frequencies independent of speed)")
+    flat = all(max(f for _, f in pts) - min(f for _, f in pts) <= 1e-9 * max(f for _, f in pts) for pts in lines.values())
+    ax.set_title("Campbell diagram (frequencies independent of speed)" if flat else
+                 "Campbell diagram (centrifugal stiffening and spin softening)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")
     fig.tight_layout()

@@ -1,0 +1,105 @@
+// `campbell` with rotating effects and the forced response at a speed, through the command
+// line: speed-dependent campbell.csv, crossings on the engine-order lines, bad input exit 2.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "cli_runner.hpp"
+
+namespace shroudsim::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A coarse 4-node sector, two harmonic indices, four speeds up to 6000 rpm (below the
+// divergence of the generator's free shroud overhangs, ~11000 rpm for the default sector).
+const char* kRotatingCase = R"(name = "coarse"
+[geometry]
+element_order = 1
+mesh_size = 0.025
+[modal]
+modes = 8
+harmonic_indices = [0, 1]
+[campbell]
+speed_rpm = [0.0, 6000.0]
+speed_points = 4
+engine_orders = [1, 8, 9]
+rotating_effects = true
+)";
+
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream s(text);
+  for (std::string line; std::getline(s, line);) {
+    std::vector<std::string> cells;
+    std::istringstream l(line);
+    for (std::string c; std::getline(l, c, ',');) cells.push_back(c);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// (speed, h, mode) -> frequency from campbell.csv.
+std::map<std::tuple<double, int, int>, double> campbell(const fs::path& file) {
+  const auto rows = csv_rows(slurp(file));
+  EXPECT_EQ(rows.front(), (std::vector<std::string>{"speed_rpm", "harmonic_index", "nodal_diameter", "mode", "frequency_hz"}));
+  std::map<std::tuple<double, int, int>, double> f;
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    f[{std::stod(rows[i][0]), std::stoi(rows[i][1]), std::stoi(rows[i][3])}] = std::stod(rows[i][4]);
+  return f;
+}
+
+TEST(CliRotating, CampbellFrequenciesDependOnSpeedAndCrossingsLieOnTheEngineOrderLines) {
+  const Scratch s("campbell_rotating");
+  s.write("case.toml", kRotatingCase);
+  const CliResult r = s.run("campbell case.toml --quiet --threads 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto f = campbell(s.dir() / "results" / "coarse" / "campbell.csv");
+  EXPECT_EQ(f.size(), 4u * 2u * 8u);  // speeds x harmonic indices x modes
+  // The first family stiffens (centrifugal stiffening beats spin softening).
+  EXPECT_GT(f.at({6000.0, 0, 1}), 1.05 * f.at({0.0, 0, 1}));
+  EXPECT_GT(f.at({6000.0, 1, 1}), 1.05 * f.at({0.0, 1, 1}));
+  // Each crossing is on its line f = EO rpm / 60, between two speed points where
+  // f_r - EO rpm / 60 changes sign.
+  const auto cross = csv_rows(slurp(s.dir() / "results" / "coarse" / "crossings.csv"));
+  ASSERT_EQ(cross.front(), (std::vector<std::string>{"engine_order", "nodal_diameter", "mode", "speed_rpm", "frequency_hz"}));
+  ASSERT_GT(cross.size(), 1u);
+  for (std::size_t i = 1; i < cross.size(); ++i) {
+    const int e = std::stoi(cross[i][0]), mode = std::stoi(cross[i][2]);
+    const double rpm = std::stod(cross[i][3]), fc = std::stod(cross[i][4]);
+    EXPECT_NEAR(fc, e * rpm / 60.0, 1e-9 * fc);
+    const int h = e % 8;
+    const double s0 = 2000.0 * std::floor(rpm / 2000.0), s1 = std::min(s0 + 2000.0, 6000.0);
+    const double g0 = f.at({s0, h, mode}) - e * s0 / 60.0, g1 = f.at({s1, h, mode}) - e * s1 / 60.0;
+    EXPECT_LE(g0 * g1, 0.0) << "EO " << e << " mode " << mode << " at " << rpm << " rpm";
+  }
+  const std::string run = slurp(s.dir() / "results" / "coarse" / "run.json");
+  EXPECT_NE(run.find("\"rotating_effects\": true"), std::string::npos);
+  EXPECT_NE(run.find("\"symbolic_analyses\": 1"), std::string::npos);  // one analysis per harmonic index
+}
+
+TEST(CliRotating, WithoutRotatingEffectsTheFrequenciesAreThoseAtRest) {
+  const Scratch s("campbell_at_rest");
+  s.write("case.toml", kRotatingCase);
+  const CliResult r = s.run("campbell case.toml --quiet --set campbell.rotating_effects=false");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto f = campbell(s.dir() / "results" / "coarse" / "campbell.csv");
+  for (const auto& [key, v] : f) EXPECT_EQ(v, f.at({0.0, std::get<1>(key), std::get<2>(key)}));
+}
+
+TEST(CliRotating, BadSpeedAndFlagValuesExitTwoNamingTheKey) {
+  const Scratch s("campbell_bad");
+  s.write("case.toml", kRotatingCase);
+  CliResult r = s.run("campbell case.toml --set campbell.rotating_effects=1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("campbell.rotating_effects"), std::string::npos) << r.err;
+  r = s.run("frf case.toml --set excitation.speed_rpm=-100");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("excitation.speed_rpm"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(s.dir() / "results" / "coarse" / "run.json"));
+}
+
+}  // namespace
+}  // namespace shroudsim::testing
