@@ -11,6 +11,7 @@ diameter), engine-order lines f = EO * rpm / 60, and the crossings where an engi
 meets a mode of the nodal diameter it excites.
 """
 import csv
+import json
 import os
 
 import matplotlib
@@ -94,6 +95,18 @@ def plot_campbell(result_dir):
     if crossings:
         ax.plot([float(c["speed_rpm"]) for c in crossings], [float(c["frequency_hz"]) for c in crossings],
                 "ro", mfc="none", ms=7, label="crossing (EO excites ND)")
+    # A sweep that stopped (a mode diverged): say where, from run.json.
+    try:
+        with open(os.path.join(result_dir, "run.json")) as f:
+            sweeps = json.load(f).get("campbell", {}).get("sweeps", [])
+        failures = [w["failure"] for w in sweeps if "failure" in w]
+    except (OSError, ValueError):
+        failures = []
+    if failures:
+        why = ("a mode diverges (K + K_sigma - Omega^2 M_spin not positive definite)"
+               if "not positive definite" in failures[0] else failures[0][:90])
+        ax.text(0.99, 0.01, "sweep stopped beyond %g rpm: %s; see run.json" % (s1, why),
+                transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color="firebrick")
     ax.set_xlim(s0, s1 * 1.06)
     ax.set_ylim(0, f_top)
     ax.set_xlabel("speed [rpm]")
