@@ -1,9 +1,13 @@
 // `shroudsim frf CASE`: nonlinear forced response by multiharmonic balance with
 // pseudo-arclength continuation -> frf.csv, loops.csv, run.json statistics.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <iomanip>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "app/context.hpp"
@@ -29,6 +33,202 @@ contact::PairParameters pair_of(const io::ContactSection& c, const io::ContactEl
   p.tangential_stiffness = e && e->tangential_stiffness ? *e->tangential_stiffness : c.tangential_stiffness;
   p.normal_preload = e && e->normal_preload ? *e->normal_preload : c.normal_preload;
   return p;
+}
+
+std::string read_file(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// (frequency, amplitude) of every row of an frf.csv.
+std::vector<std::pair<double, double>> read_curve(const std::filesystem::path& file) {
+  std::vector<std::pair<double, double>> curve;
+  std::istringstream in(read_file(file));
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    std::string f, a;
+    if (std::getline(row, f, ',') && std::getline(row, a, ',')) curve.emplace_back(std::stod(f), std::stod(a));
+  }
+  return curve;
+}
+
+/// The largest relative change between two forced-response curves at their resonance peaks:
+/// for every local maximum of either curve at least 20 % of its largest, the two curves'
+/// peaks within +-2 % of its frequency are compared. One number for the whole range, so
+/// that a resonance smaller than the largest (and the one that needs more harmonics) counts.
+double peaks_change(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b) {
+  double worst = 0.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto& x = pass == 0 ? a : b;
+    const auto& y = pass == 0 ? b : a;
+    double top = 0.0;
+    for (const auto& p : x) top = std::max(top, p.second);
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const double v = x[i].second;
+      if (v < 0.2 * top || (i > 0 && x[i - 1].second > v) || (i + 1 < x.size() && x[i + 1].second > v)) continue;
+      // Window peaks of both curves (a fold's local maximum next to a taller peak compares
+      // that peak, in both).
+      double mine = 0.0, other = 0.0;
+      for (const auto& q : x)
+        if (std::abs(q.first - x[i].first) <= 0.02 * x[i].first) mine = std::max(mine, q.second);
+      for (const auto& q : y)
+        if (std::abs(q.first - x[i].first) <= 0.02 * x[i].first) other = std::max(other, q.second);
+      worst = std::max(worst, other > 0 ? std::abs(mine - other) / std::max(mine, other) : 1.0);
+    }
+  }
+  return worst;
+}
+
+/// hbm.harmonics and/or hbm.time_samples = "auto": the forced response is traced with H
+/// raised through 1, 3, 5, 7, 10, 15, 20, 25, 35, ... (up to hbm.auto_max_harmonics), then N
+/// doubled from the smallest power of two >= 4 (2H + 1), at least 64 (up to
+/// hbm.auto_max_time_samples), each until the peak amplitudes change by less than
+/// hbm.auto_tolerance (relative) from the previous trial (every resonance peak of the range
+/// at least 20 % of the largest, see peaks_change). While H is sought with N on
+/// "auto", N is the power of two >= 16 (2H + 1), at least 256. Every trial is a full curve in
+/// <out>/auto/H=..__N=../; the accepted trial's frf.csv and loops.csv are the result, and
+/// run.json lists every trial under "auto".
+int frf_auto(Context& ctx) {
+  const io::Case& c = ctx.config;
+  log::Stopwatch clock;
+  auto pow2_at_least = [](int v) {
+    int p = 1;
+    while (p < v) p *= 2;
+    return p;
+  };
+  struct Trial {
+    int h = 0, n = 0, status = 0;
+    double peak = 0.0, peak_f = 0.0, seconds = 0.0, change = -1.0;
+    std::string message;
+    nlohmann::json frf;
+    std::filesystem::path dir;
+  };
+  std::vector<Trial> trials;  // every trial, in order (std::deque-like use: only appended)
+  trials.reserve(64);
+  const bool verbose = log::verbose();
+  // previous: the trial this one is compared with (null for the first of a search).
+  auto run_trial = [&](int h, int n, const Trial* previous) -> Trial {
+    Trial t;
+    t.h = h;
+    t.n = n;
+    Context tc;
+    tc.config = c;
+    tc.config.hbm.harmonics = h;
+    tc.config.hbm.harmonics_auto = false;
+    tc.config.hbm.time_samples = n;
+    tc.config.hbm.time_samples_auto = false;
+    tc.out_dir = ctx.out_dir / "auto" / ("H=" + std::to_string(h) + "__N=" + std::to_string(n));
+    tc.threads = ctx.threads;
+    tc.overrides = ctx.overrides;
+    tc.plots = false;
+    t.dir = tc.out_dir;
+    log::Stopwatch tclock;
+    log::set_verbose(false);
+    try {
+      t.status = cmd_frf(tc);
+    } catch (const NumericalError& e) {
+      t.status = 3, t.message = e.what();
+    } catch (...) {
+      log::set_verbose(verbose);
+      throw;
+    }
+    log::set_verbose(verbose);
+    t.seconds = tclock.seconds();
+    t.frf = tc.report.json().value("frf", nlohmann::json::object());
+    t.peak = t.frf.value("peak_amplitude_m", 0.0);
+    t.peak_f = t.frf.value("peak_frequency_hz", 0.0);
+    if (previous && t.peak > 0 && t.status == 0 && previous->status == 0)
+      t.change = peaks_change(read_curve(previous->dir / "frf.csv"), read_curve(t.dir / "frf.csv"));
+    std::ostringstream s;
+    s << "frf: auto: H = " << h << ", N = " << n << ": "
+      << (t.status == 0 ? "peak " : "failed (" + t.message + "), peak so far ") << std::scientific << std::setprecision(4)
+      << t.peak << " m at " << std::defaultfloat << std::setprecision(6) << t.peak_f << " Hz";
+    if (t.change >= 0) s << ", change " << std::setprecision(2) << 100 * t.change << " %";
+    s << " (" << std::setprecision(3) << t.seconds << " s)";
+    log::info(s.str());
+    return t;
+  };
+  const double tol = c.hbm.auto_tolerance;
+  bool converged_h = !c.hbm.harmonics_auto, converged_n = !c.hbm.time_samples_auto;
+  int h = c.hbm.harmonics, n = c.hbm.time_samples;
+  if (c.hbm.harmonics_auto) {
+    // No H = 2 step: a symmetric motion has no even harmonics, and 1 -> 2 would "converge".
+    std::vector<int> ladder = {1, 3, 5, 7, 10, 15, 20, 25};
+    for (int k = 35; k <= 200; k += 10) ladder.push_back(k);
+    for (int hk : ladder) {
+      if (hk > c.hbm.auto_max_harmonics) break;
+      const int nk = c.hbm.time_samples_auto ? std::max(256, pow2_at_least(16 * (2 * hk + 1))) : c.hbm.time_samples;
+      if (nk < 2 * hk + 1) break;  // a fixed N limits H
+      trials.push_back(run_trial(hk, nk, trials.empty() ? nullptr : &trials.back()));
+      const Trial& t = trials.back();
+      h = hk, n = nk;
+      if (t.change >= 0 && t.change < tol) {
+        converged_h = true;
+        break;
+      }
+    }
+  }
+  if (c.hbm.time_samples_auto) {
+    std::optional<std::size_t> last;  // index of the previous trial of this search
+    for (int nk = std::max(64, pow2_at_least(4 * (2 * h + 1))); nk <= c.hbm.auto_max_time_samples; nk *= 2) {
+      // The trial at (h, nk) may have been run while H was sought: reuse it.
+      std::optional<std::size_t> here;
+      for (std::size_t i = 0; i < trials.size(); ++i)
+        if (trials[i].h == h && trials[i].n == nk) here = i;
+      if (!here) {
+        trials.push_back(run_trial(h, nk, last ? &trials[*last] : nullptr));
+        here = trials.size() - 1;
+      } else if (last) {
+        Trial& t = trials[*here];
+        const Trial& p = trials[*last];
+        t.change = t.status == 0 && p.status == 0 && t.peak > 0
+                       ? peaks_change(read_curve(p.dir / "frf.csv"), read_curve(t.dir / "frf.csv"))
+                       : -1.0;
+      }
+      n = nk;
+      const double change = last ? trials[*here].change : -1.0;
+      last = here;
+      if (change >= 0 && change < tol) {
+        converged_n = true;
+        break;
+      }
+    }
+  }
+  // The accepted trial: the last one run at the chosen (h, n).
+  const Trial* chosen = nullptr;
+  for (const auto& t : trials)
+    if (t.h == h && t.n == n) chosen = &t;
+  if (!chosen) throw InputError(c.locations.at("hbm.harmonics") + ": hbm \"auto\": no H/N candidate fits the limits (auto_max_harmonics, auto_max_time_samples, time_samples >= 2H+1)");
+  for (const char* f : {"frf.csv", "loops.csv"})
+    if (std::filesystem::exists(chosen->dir / f)) io::write_file_atomic(ctx.out_dir / f, read_file(chosen->dir / f));
+  ctx.report.section("frf") = chosen->frf;
+  auto& a = ctx.report.section("auto");
+  a["tolerance"] = tol;
+  a["harmonics"] = h;
+  a["time_samples"] = n;
+  a["harmonics_converged"] = converged_h;
+  a["time_samples_converged"] = converged_n;
+  a["trials"] = nlohmann::json::array();
+  for (const auto& t : trials)
+    a["trials"].push_back({{"harmonics", t.h}, {"time_samples", t.n}, {"status", t.status == 0 ? "ok" : "numerics_failed"},
+                          {"peak_amplitude_m", t.peak}, {"peak_frequency_hz", t.peak_f}, {"seconds", t.seconds},
+                          {"relative_change", t.change >= 0 ? nlohmann::json(t.change) : nlohmann::json(nullptr)}});
+  ctx.report.stage("frf", clock.seconds());
+  log::info("frf: auto chose H = " + std::to_string(h) + ", N = " + std::to_string(n) + " (" +
+            std::to_string(trials.size()) + " trials)");
+  if (!converged_h)
+    ctx.report.warn("hbm.harmonics = \"auto\": the peak still changed by more than " + io::format_number(tol) +
+                    " at H = " + std::to_string(h) + " (hbm.auto_max_harmonics or the fixed time_samples stopped the search)");
+  if (!converged_n)
+    ctx.report.warn("hbm.time_samples = \"auto\": the peak still changed by more than " + io::format_number(tol) +
+                    " at N = " + std::to_string(n) + " (hbm.auto_max_time_samples)");
+  draw_plots(ctx);
+  if (chosen->status != 0) throw NumericalError("with H = " + std::to_string(h) + ", N = " + std::to_string(n) + ": " + chosen->message);
+  return 0;
 }
 
 }  // namespace
@@ -72,8 +272,7 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
 
 int cmd_frf(Context& ctx) {
   const io::Case& c = ctx.config;
-  if (c.hbm.harmonics_auto || c.hbm.time_samples_auto)
-    throw InputError(c.locations.at("hbm.harmonics") + ": hbm.harmonics/time_samples = \"auto\" is not available yet (planned in issue 6)");
+  if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return frf_auto(ctx);
   log::Stopwatch clock;
   ForcedModel model = c.structure.type == "lumped" ? make_lumped_model(c) : make_sector_model(ctx);
   for (const auto& p : model.pairs) {

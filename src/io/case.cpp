@@ -531,6 +531,11 @@ void read_all(Reader& r, Case& c) {
   h.tolerance = r.number("hbm.tolerance", [](double v) -> std::optional<std::string> {
     return v > 0 && v < 1 ? std::nullopt : std::optional<std::string>("0 < tolerance < 1");
   });
+  h.auto_tolerance = r.number("hbm.auto_tolerance", [](double v) -> std::optional<std::string> {
+    return v > 0 && v < 1 ? std::nullopt : std::optional<std::string>("0 < auto_tolerance < 1");
+  });
+  h.auto_max_harmonics = r.integer("hbm.auto_max_harmonics", in_range_int(1, 200));
+  h.auto_max_time_samples = r.integer("hbm.auto_max_time_samples", in_range_int(16, 65536));
 
   auto& cn = c.continuation;
   cn.frequency_start_hz = r.number("continuation.frequency_start_hz", positive);

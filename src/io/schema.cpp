@@ -85,6 +85,9 @@ const std::vector<KeySpec>& case_schema() {
       {"hbm.time_samples", "512", "N >= 2H+1, <= 65536, or \"auto\"", "N: time samples per period"},
       {"hbm.jacobian", "\"analytic\"", "\"analytic\" | \"finite_difference\"", "Jacobian of the contact forces"},
       {"hbm.tolerance", "1e-8", "0 < tol < 1", "Newton tolerance on the scaled residual"},
+      {"hbm.auto_tolerance", "0.01", "0 < tol < 1", "\"auto\" H or N: stop when the peak amplitude changes by less (relative)"},
+      {"hbm.auto_max_harmonics", "25", "1 <= H <= 200", "\"auto\" harmonics: largest H tried"},
+      {"hbm.auto_max_time_samples", "4096", "16 <= N <= 65536", "\"auto\" time samples: largest N tried"},
 
       {"continuation.frequency_start_hz", "100.0", "> 0", "start of the frequency range (Hz)"},
       {"continuation.frequency_end_hz", "220.0", "> 0, != start", "end of the frequency range (Hz)"},

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "cli_runner.hpp"
@@ -185,6 +186,40 @@ TEST(Cli, FrfWritesTheContractColumnsAndNoNaN) {
   const std::string run = slurp(s.dir() / "results" / "jenkins" / "run.json");
   EXPECT_NE(run.find("\"max_energy_balance_error\""), std::string::npos);
   EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "loops.csv"));
+}
+
+TEST(Cli, AutoHarmonicsAndSamplesStopWhereThePeaksSettle) {
+  const Scratch s("auto");
+  s.write("case.toml", kLumpedCase);
+  constexpr double kAutoTol = 1e-3;
+  const CliResult r = s.run("frf case.toml --quiet --set hbm.harmonics=\"auto\" --set hbm.time_samples=\"auto\" "
+                            "--set hbm.auto_tolerance=" + std::to_string(kAutoTol));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto run = nlohmann::json::parse(slurp(s.dir() / "results" / "jenkins" / "run.json"));
+  const auto& a = run.at("auto");
+  const int h = a.at("harmonics"), n = a.at("time_samples");
+  EXPECT_TRUE(a.at("harmonics_converged").get<bool>());
+  EXPECT_TRUE(a.at("time_samples_converged").get<bool>());
+  EXPECT_GE(n, 2 * h + 1);
+  // The H search stops at the first H whose curve is within the tolerance of the one before,
+  // and the N search likewise: the accepted trials met it, the ones before them did not.
+  std::vector<nlohmann::json> h_trials, n_trials;
+  for (const auto& t : a.at("trials")) (t.at("time_samples") == n && t.at("harmonics") == h ? n_trials : h_trials).push_back(t);
+  ASSERT_FALSE(n_trials.empty());
+  const auto& accepted = n_trials.back();
+  ASSERT_FALSE(accepted.at("relative_change").is_null());
+  EXPECT_LT(accepted.at("relative_change").get<double>(), kAutoTol);
+  int h_search_below = 0;
+  for (const auto& t : a.at("trials"))
+    if (t.at("harmonics") != h && !t.at("relative_change").is_null() && t.at("relative_change").get<double>() < kAutoTol)
+      ++h_search_below;
+  EXPECT_EQ(h_search_below, 0) << "the H search went past an H that already met the tolerance";
+  EXPECT_GE(a.at("trials").size(), 3u);
+  // The result is the accepted trial's curve, with its harmonics as columns.
+  const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "frf.csv"));
+  ASSERT_GT(lines.size(), 20u);
+  EXPECT_NE(lines[0].find(",h" + std::to_string(h) + "_m,piece"), std::string::npos) << lines[0];
+  EXPECT_EQ(lines[0].find(",h" + std::to_string(h + 1) + "_m"), std::string::npos) << lines[0];
 }
 
 TEST(Cli, ContinuationThatCannotFinishExitsThreeWithWhatItHas) {
