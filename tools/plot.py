@@ -10,6 +10,7 @@ Draws whatever the folder holds results for:
   frf.csv              -> frf.png           (nonlinear and linear forced response)
   loops.csv            -> loops.png         (contact loops at the peak)
   study.csv            -> study.png         (peak amplitude and frequency over a sweep)
+  trade.csv            -> trade.png         (error against cost per knob, study --convergence)
 Exits 0 when it drew everything it found, 1 on a plotting failure, 2 on bad usage.
 """
 import importlib
@@ -26,6 +27,7 @@ PLOTS = [
     ("contact.json", "plotting.contact_plots", "plot_contact"),
     ("frf.csv", "plotting.frf_plots", "plot_frf"),
     ("study.csv", "plotting.study_plots", "plot_study"),
+    ("trade.csv", "plotting.study_plots", "plot_trade"),
 ]
 
 

@@ -24,6 +24,7 @@ struct CommonOptions {
   std::string out;
   bool quiet = false;
   int threads = 0;
+  bool convergence = false;  ///< study only
 };
 
 void add_common(CLI::App* sub, CommonOptions& o) {
@@ -108,6 +109,10 @@ int run_cli(int argc, char** argv) {
   for (std::size_t i = 0; i < subs.size(); ++i) {
     CLI::App* sub = app.add_subcommand(subs[i].name, subs[i].help);
     add_common(sub, options[i]);
+    if (subs[i].name == "study")
+      sub->add_flag("--convergence", options[i].convergence,
+                    "vary every accuracy knob (mesh, modes, residual flexibility, H, N, update, model, Jacobian) "
+                    "around the case against its finest value -> trade.csv, trade.png");
     commands.push_back(sub);
   }
 
@@ -153,6 +158,7 @@ int run_cli(int argc, char** argv) {
   ctx.out_dir = o.out.empty() ? std::filesystem::path("results") / ctx.config.name : std::filesystem::path(o.out);
   ctx.threads = o.threads;
   ctx.overrides = o.sets;
+  ctx.convergence = o.convergence;
   const std::string command = subs[chosen].name;
 
   int status = 1;

@@ -12,6 +12,7 @@
 
 #include "app/context.hpp"
 #include "app/forced_stage.hpp"
+#include "app/frf_curves.hpp"
 #include "app/modal_stage.hpp"
 #include "continuation/arclength.hpp"
 #include "core/error.hpp"
@@ -33,54 +34,6 @@ contact::PairParameters pair_of(const io::ContactSection& c, const io::ContactEl
   p.tangential_stiffness = e && e->tangential_stiffness ? *e->tangential_stiffness : c.tangential_stiffness;
   p.normal_preload = e && e->normal_preload ? *e->normal_preload : c.normal_preload;
   return p;
-}
-
-std::string read_file(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// (frequency, amplitude) of every row of an frf.csv.
-std::vector<std::pair<double, double>> read_curve(const std::filesystem::path& file) {
-  std::vector<std::pair<double, double>> curve;
-  std::istringstream in(read_file(file));
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) {
-    std::istringstream row(line);
-    std::string f, a;
-    if (std::getline(row, f, ',') && std::getline(row, a, ',')) curve.emplace_back(std::stod(f), std::stod(a));
-  }
-  return curve;
-}
-
-/// The largest relative change between two forced-response curves at their resonance peaks:
-/// for every local maximum of either curve at least 20 % of its largest, the two curves'
-/// peaks within +-2 % of its frequency are compared. One number for the whole range, so
-/// that a resonance smaller than the largest (and the one that needs more harmonics) counts.
-double peaks_change(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b) {
-  double worst = 0.0;
-  for (int pass = 0; pass < 2; ++pass) {
-    const auto& x = pass == 0 ? a : b;
-    const auto& y = pass == 0 ? b : a;
-    double top = 0.0;
-    for (const auto& p : x) top = std::max(top, p.second);
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      const double v = x[i].second;
-      if (v < 0.2 * top || (i > 0 && x[i - 1].second > v) || (i + 1 < x.size() && x[i + 1].second > v)) continue;
-      // Window peaks of both curves (a fold's local maximum next to a taller peak compares
-      // that peak, in both).
-      double mine = 0.0, other = 0.0;
-      for (const auto& q : x)
-        if (std::abs(q.first - x[i].first) <= 0.02 * x[i].first) mine = std::max(mine, q.second);
-      for (const auto& q : y)
-        if (std::abs(q.first - x[i].first) <= 0.02 * x[i].first) other = std::max(other, q.second);
-      worst = std::max(worst, other > 0 ? std::abs(mine - other) / std::max(mine, other) : 1.0);
-    }
-  }
-  return worst;
 }
 
 /// hbm.harmonics and/or hbm.time_samples = "auto": the forced response is traced with H

@@ -3,16 +3,20 @@
 // line's own), run in its own folder <out>/<key=value__key=value...>/ with its own run.json; points
 // run in parallel on --threads workers. study.csv lists every point with its status, peak
 // amplitude and frequency; study.png plots the peak against the first varied key.
+// `study --convergence CASE` instead measures the accuracy/speed trade of the case's knobs
+// (run_convergence below) -> trade.csv, trade.png; it needs no [study] section.
 #include <algorithm>
 #include <atomic>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
 #include "app/context.hpp"
+#include "app/frf_curves.hpp"
 #include "app/modal_stage.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -42,36 +46,10 @@ std::string folder_name(const std::vector<std::pair<std::string, std::string>>& 
   return s;
 }
 
-}  // namespace
-
-int cmd_study(Context& ctx) {
-  const io::Case& base = ctx.config;
-  if (base.study.vary.empty())
-    throw InputError(base.locations.at("study.vary") + ": study.vary is empty: name at least one key and its values");
-  // Cartesian product, first key slowest.
-  std::vector<StudyPoint> points(1);
-  for (const auto& [key, values] : base.study.vary) {
-    std::vector<StudyPoint> next;
-    for (const auto& p : points)
-      for (const auto& v : values) {
-        StudyPoint q = p;
-        q.values.emplace_back(key, v);
-        next.push_back(q);
-      }
-    points = next;
-  }
-  // Every point is validated before any runs: a bad value is an input error up front.
-  std::vector<io::Case> cases;
-  for (auto& p : points) {
-    std::vector<std::string> sets = ctx.overrides;
-    for (const auto& [k, v] : p.values) sets.push_back(k + "=" + v);
-    try {
-      cases.push_back(io::load_case(base.file, sets));
-    } catch (const InputError& e) {
-      throw InputError(base.locations.at("study.vary") + ": study point " + folder_name(p.values) + ": " + e.what());
-    }
-    p.folder = folder_name(p.values);
-  }
+/// Runs every point (the case `cases[i]` into <out>/<points[i].folder>) on --threads workers,
+/// quietly, one line each; fills status, message, peak, points and seconds. Returns the
+/// number of workers used.
+int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<StudyPoint>& points) {
   const int workers = std::max(1, std::min<int>(ctx.threads > 0 ? ctx.threads : static_cast<int>(std::thread::hardware_concurrency()),
                                                  static_cast<int>(points.size())));
   log::info("study: " + std::to_string(points.size()) + " points on " + std::to_string(workers) + " workers");
@@ -126,6 +104,180 @@ int cmd_study(Context& ctx) {
   for (int t = 0; t < workers; ++t) pool.emplace_back(work);
   for (auto& t : pool) t.join();
   log::set_verbose(verbose);
+  return workers;
+
+}
+
+
+/// `study --convergence`: every knob of the accuracy/speed trade varied one at a time around
+/// the case's own setting, each against its finest value (the reference), with every other
+/// knob at the case's setting. The error of a point is peaks_change (frf_curves.hpp) between
+/// its curve and the reference's (the largest relative change at any resonance peak of the
+/// range) and the shift of the largest peak's frequency; its cost is its wall time (a run
+/// that has to build a new mesh and its modes pays for them). -> trade.csv, trade.png.
+int run_convergence(Context& ctx) {
+  const io::Case& c = ctx.config;
+  const bool sector = c.structure.type == "sector";
+  auto num = [](double v) { return io::format_number(v); };
+  auto quoted = [](const std::string& v) { return "\"" + v + "\""; };
+  struct Knob {
+    std::string name, key;
+    std::vector<std::string> values;  ///< TOML value texts, coarse to fine
+    std::vector<std::pair<std::string, std::string>> reference;  ///< overrides of the reference point
+  };
+  std::vector<Knob> knobs;
+  if (sector && c.structure.mesh.empty()) {
+    const double m = c.geometry.mesh_size;
+    knobs.push_back({"mesh size [m]", "geometry.mesh_size", {num(m), num(0.8 * m), num(0.65 * m)}, {}});
+  }
+  if (sector) {
+    const int modes = c.modal.modes;
+    knobs.push_back({"modes kept", "modal.modes", {std::to_string(std::max(5, modes / 2)), std::to_string(modes), std::to_string(2 * modes)}, {}});
+    knobs.push_back({"residual flexibility", "modal.residual_flexibility", {"false", "true"}, {}});
+  }
+  const int h = c.hbm.harmonics_auto ? 5 : c.hbm.harmonics;
+  const int n = c.hbm.time_samples_auto ? 512 : c.hbm.time_samples;
+  const bool exact_1d = c.contact.model == "1d_exact";
+  if (!exact_1d) {
+    std::vector<std::string> hs;
+    for (int v : {1, 3, h, 2 * h})
+      if (v >= 1 && 2 * v + 1 <= 4 * n && (hs.empty() || std::to_string(v) != hs.back()) && v <= 200) hs.push_back(std::to_string(v));
+    std::sort(hs.begin(), hs.end(), [](const std::string& a, const std::string& b) { return std::stoi(a) < std::stoi(b); });
+    hs.erase(std::unique(hs.begin(), hs.end()), hs.end());
+    // The finest H needs N >= 2H + 1: the reference runs at 4 N.
+    knobs.push_back({"harmonics H", "hbm.harmonics", hs, {{"hbm.time_samples", std::to_string(4 * n)}}});
+    std::vector<std::string> ns;
+    for (int v : {n / 8, n / 4, n / 2, n, 4 * n})
+      if (v >= std::max(16, 2 * h + 1) && v <= 65536) ns.push_back(std::to_string(v));
+    ns.erase(std::unique(ns.begin(), ns.end()), ns.end());
+    knobs.push_back({"time samples N", "hbm.time_samples", ns, {}});
+    if (c.contact.model == "full3d" || c.contact.model == "quasi3d") {
+      knobs.push_back({"tangential update", "contact.tangential_update", {quoted("radial_return"), quoted("exact_linear")},
+                       {{"hbm.time_samples", std::to_string(4 * n)}}});
+      knobs.push_back({"contact model", "contact.model", {quoted("quasi3d"), quoted("full3d")}, {}});
+    }
+    knobs.push_back({"Jacobian", "hbm.jacobian", {quoted("finite_difference"), quoted("analytic")}, {}});
+  }
+  if (knobs.empty())
+    throw InputError(c.file.string() + ": study --convergence: this case has no knob to vary");
+
+  // Points: one per distinct set of overrides (the case itself appears under several knobs).
+  std::vector<StudyPoint> points;
+  std::map<std::string, std::size_t> index;
+  auto point_of = [&](std::vector<std::pair<std::string, std::string>> values) {
+    std::sort(values.begin(), values.end());
+    // Overrides equal to the case's own setting are dropped, so equal points merge.
+    std::vector<std::pair<std::string, std::string>> kept;
+    for (const auto& [k, v] : values) {
+      const io::Case probe = io::load_case(c.file, [&] {
+        std::vector<std::string> sets = ctx.overrides;
+        sets.push_back(k + "=" + v);
+        return sets;
+      }());
+      if (probe.resolved_json != c.resolved_json) kept.emplace_back(k, v);
+    }
+    const std::string name = kept.empty() ? "case" : folder_name(kept);
+    auto [it, fresh] = index.emplace(name, points.size());
+    if (fresh) {
+      StudyPoint p;
+      p.values = kept;
+      p.folder = name;
+      points.push_back(p);
+    }
+    return it->second;
+  };
+  struct Row {
+    std::size_t knob, point, reference;
+    std::string value;
+  };
+  std::vector<Row> rows;
+  try {
+    for (std::size_t k = 0; k < knobs.size(); ++k) {
+      auto ref = knobs[k].reference;
+      ref.emplace_back(knobs[k].key, knobs[k].values.back());
+      const std::size_t r = point_of(ref);
+      for (const auto& v : knobs[k].values) {
+        auto values = knobs[k].reference;
+        if (v != knobs[k].values.back()) values.clear();  // coarser values at the case's other settings
+        values.emplace_back(knobs[k].key, v);
+        rows.push_back({k, point_of(values), r, v});
+      }
+    }
+  } catch (const InputError& e) {
+    throw InputError(c.file.string() + ": study --convergence: a varied value is not valid for this case: " + e.what());
+  }
+  std::vector<io::Case> cases;
+  for (const auto& p : points) {
+    std::vector<std::string> sets = ctx.overrides;
+    for (const auto& [k, v] : p.values) sets.push_back(k + "=" + v);
+    cases.push_back(io::load_case(c.file, sets));
+  }
+  log::info("study --convergence: " + std::to_string(knobs.size()) + " knobs, " + std::to_string(points.size()) + " runs");
+  const int workers = run_points(ctx, cases, points);
+
+  std::ostringstream csv;
+  csv << "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,peaks_error,"
+         "peak_frequency_error_hz,folder\n";
+  int failed = 0;
+  for (const auto& row : rows) {
+    const StudyPoint& p = points[row.point];
+    const StudyPoint& r = points[row.reference];
+    const bool ok = p.status == 0 && r.status == 0;
+    double err = 0.0, ferr = 0.0;
+    if (ok) {
+      err = peaks_change(read_curve(ctx.out_dir / p.folder / "frf.csv"), read_curve(ctx.out_dir / r.folder / "frf.csv"));
+      ferr = std::abs(p.peak_frequency - r.peak_frequency);
+    }
+    std::string value = row.value, ref = knobs[row.knob].values.back();
+    for (std::string* t : {&value, &ref}) t->erase(std::remove(t->begin(), t->end(), '"'), t->end());
+    csv << knobs[row.knob].name << "," << knobs[row.knob].key << "," << value << "," << ref << ","
+        << (p.status == 0 ? "ok" : "failed") << "," << num(p.seconds) << "," << p.points << "," << num(p.peak) << ","
+        << num(p.peak_frequency) << "," << (ok ? num(err) : "") << "," << (ok ? num(ferr) : "") << "," << p.folder << "\n";
+    failed += p.status != 0;
+  }
+  io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());
+  ctx.report.section("study") = {{"convergence", true}, {"runs", points.size()}, {"knobs", knobs.size()},
+                                 {"failed_rows", failed}, {"workers", workers}};
+  draw_plots(ctx);
+  if (failed) {
+    ctx.report.warn(std::to_string(failed) + " rows of trade.csv failed (see their folders' run.json)");
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int cmd_study(Context& ctx) {
+  if (ctx.convergence) return run_convergence(ctx);
+  const io::Case& base = ctx.config;
+  if (base.study.vary.empty())
+    throw InputError(base.locations.at("study.vary") + ": study.vary is empty: name at least one key and its values");
+  // Cartesian product, first key slowest.
+  std::vector<StudyPoint> points(1);
+  for (const auto& [key, values] : base.study.vary) {
+    std::vector<StudyPoint> next;
+    for (const auto& p : points)
+      for (const auto& v : values) {
+        StudyPoint q = p;
+        q.values.emplace_back(key, v);
+        next.push_back(q);
+      }
+    points = next;
+  }
+  // Every point is validated before any runs: a bad value is an input error up front.
+  std::vector<io::Case> cases;
+  for (auto& p : points) {
+    std::vector<std::string> sets = ctx.overrides;
+    for (const auto& [k, v] : p.values) sets.push_back(k + "=" + v);
+    try {
+      cases.push_back(io::load_case(base.file, sets));
+    } catch (const InputError& e) {
+      throw InputError(base.locations.at("study.vary") + ": study point " + folder_name(p.values) + ": " + e.what());
+    }
+    p.folder = folder_name(p.values);
+  }
+  const int workers = run_points(ctx, cases, points);
 
   std::ostringstream csv;
   for (const auto& [k, v] : points.front().values) csv << k << ",";

@@ -34,6 +34,7 @@ struct Context {
   int threads = 0;                  ///< 0: all cores
   std::vector<std::string> overrides;  ///< the command line's --set KEY=VALUE, in order
   bool plots = true;                ///< draw plots after a command (off for study points)
+  bool convergence = false;         ///< `study --convergence`: the accuracy/speed trade
   RunReport report;
 };
 

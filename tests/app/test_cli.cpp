@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -220,6 +221,43 @@ TEST(Cli, AutoHarmonicsAndSamplesStopWhereThePeaksSettle) {
   ASSERT_GT(lines.size(), 20u);
   EXPECT_NE(lines[0].find(",h" + std::to_string(h) + "_m,piece"), std::string::npos) << lines[0];
   EXPECT_EQ(lines[0].find(",h" + std::to_string(h + 1) + "_m"), std::string::npos) << lines[0];
+}
+
+TEST(Cli, ConvergenceStudyTabulatesEveryKnobAgainstItsFinestValue) {
+  const Scratch s("convergence");
+  s.write("case.toml", kLumpedCase);
+  const CliResult r = s.run("study --convergence case.toml --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "trade.csv"));
+  ASSERT_GT(lines.size(), 1u);
+  EXPECT_EQ(lines[0], "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,"
+                      "peaks_error,peak_frequency_error_hz,folder");
+  // Rows per knob, in the order coarse to fine: (value, error).
+  std::map<std::string, std::vector<std::pair<std::string, double>>> knobs;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    std::vector<std::string> f;
+    std::istringstream row(lines[i]);
+    for (std::string x; std::getline(row, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 12u) << lines[i];
+    EXPECT_EQ(f[4], "ok") << lines[i];
+    knobs[f[1]].emplace_back(f[2], std::stod(f[9]));
+    if (f[2] == f[3]) {
+      EXPECT_EQ(std::stod(f[9]), 0.0) << "a reference has no error against itself: " << lines[i];
+    }
+  }
+  // A 1d lumped case: no mesh, modes, update or contact-model knobs.
+  EXPECT_EQ(knobs.size(), 3u);
+  ASSERT_TRUE(knobs.count("hbm.harmonics") && knobs.count("hbm.time_samples") && knobs.count("hbm.jacobian"));
+  // More harmonics and more samples converge: the error against the finest falls along the list.
+  for (const char* key : {"hbm.harmonics", "hbm.time_samples"}) {
+    const auto& v = knobs[key];
+    ASSERT_GE(v.size(), 3u) << key;
+    for (std::size_t i = 1; i < v.size(); ++i) EXPECT_LE(v[i].second, v[i - 1].second) << key << " = " << v[i].first;
+  }
+  // The finite-difference Jacobian traces the same curve (to its step, 1e-6 relative).
+  constexpr double kSameCurve = 1e-6;
+  EXPECT_LT(knobs["hbm.jacobian"].front().second, kSameCurve);
+  EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "case" / "frf.csv"));
 }
 
 TEST(Cli, ContinuationThatCannotFinishExitsThreeWithWhatItHas) {

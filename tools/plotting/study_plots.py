@@ -45,3 +45,53 @@ def plot_study(result_dir):
     fig.tight_layout()
     fig.savefig(os.path.join(result_dir, "study.png"), dpi=110)
     plt.close(fig)
+
+
+def plot_trade(result_dir):
+    """trade.png (`study --convergence`): error against wall time, one marker series per knob,
+    each point labelled with its value; the references (error 0) are listed in the legend,
+    not drawn. The lower-left hull is the Pareto front: nothing is both cheaper and better."""
+    import matplotlib.pyplot as plt
+
+    with open(os.path.join(result_dir, "trade.csv"), newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["status"] == "ok" and r["peaks_error"] != ""]
+    if not rows:
+        return
+    knobs = []
+    for r in rows:
+        if r["knob"] not in knobs:
+            knobs.append(r["knob"])
+    fig, ax = plt.subplots(figsize=(9, 6))
+    floor = min([float(r["peaks_error"]) for r in rows if float(r["peaks_error"]) > 0] or [1e-12]) / 3
+    pts = []
+    markers = "osD^v<>ph*"
+    for i, k in enumerate(knobs):
+        sel = [r for r in rows if r["knob"] == k]
+        ref = next((r for r in sel if float(r["peaks_error"]) == 0), None)
+        xs = [float(r["seconds"]) for r in sel if float(r["peaks_error"]) > 0]
+        ys = [float(r["peaks_error"]) for r in sel if float(r["peaks_error"]) > 0]
+        label = k + (f" (reference {ref['value']}: {float(ref['seconds']):.3g} s)" if ref else "")
+        ax.loglog(xs, ys, markers[i % len(markers)], ls="-", lw=0.8, label=label)
+        for r in sel:
+            if float(r["peaks_error"]) > 0:
+                ax.annotate(r["value"], (float(r["seconds"]), float(r["peaks_error"])), fontsize=7,
+                            textcoords="offset points", xytext=(4, 3))
+                pts.append((float(r["seconds"]), float(r["peaks_error"])))
+    pts.sort()
+    front, best = [], float("inf")
+    for x, y in pts:
+        if y < best:
+            front.append((x, y))
+            best = y
+    if len(front) > 1:
+        ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="0.5", lw=0.8, ls=":",
+                label="Pareto front")
+    ax.set_ylim(bottom=floor)
+    ax.set_xlabel("wall time of the run [s]")
+    ax.set_ylabel("largest relative change of a resonance peak vs the knob's reference")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title(os.path.basename(os.path.normpath(result_dir)) + ": accuracy against cost, one knob at a time")
+    fig.tight_layout()
+    fig.savefig(os.path.join(result_dir, "trade.png"), dpi=110)
+    plt.close(fig)
