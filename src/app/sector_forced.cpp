@@ -2,16 +2,19 @@
 // order reaches, shroud contact pairs with frames and tributary areas, excitation and
 // response nodes (PHYSICS.md sections 2 and 3).
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <set>
+#include <tuple>
 #include <sstream>
 
 #include "app/forced_stage.hpp"
 #include "app/modal_stage.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/output.hpp"
 #include "frf/sector.hpp"
 
 namespace shroudsim::app {
@@ -157,6 +160,25 @@ ForcedModel make_sector_model(Context& ctx) {
   forcing.excitation_node = nearest_node(mesh, c.excitation.point);
   forcing.force = Eigen::Vector3d(c.excitation.force[0], c.excitation.force[1], c.excitation.force[2]);
   forcing.response_node = nearest_node(mesh, c.response.point);
+  // A point whose nearest node is clamped, or that lies off the sector, would give a silent
+  // zero (or meaningless) response: an input error naming the key.
+  {
+    const auto& hub = mesh.node_set("hub");
+    const double size = (mesh.nodes.colwise().maxCoeff() - mesh.nodes.colwise().minCoeff()).norm();
+    for (const auto& [key, point, node] : {std::tuple{std::string("excitation.point"), c.excitation.point, forcing.excitation_node},
+                                           std::tuple{std::string("response.point"), c.response.point, forcing.response_node}}) {
+      const Eigen::RowVector3d x(point[0], point[1], point[2]);
+      const double distance = (mesh.nodes.row(node) - x).norm();
+      const auto it = c.locations.find(key);
+      const std::string where = it != c.locations.end() ? it->second : c.file.string();
+      if (std::find(hub.begin(), hub.end(), node) != hub.end())
+        throw InputError(where + ": " + key + ": the nearest node (" + std::to_string(node) +
+                         ") is on the clamped hub: it does not move; give a point on the blade or shroud");
+      if (distance > 0.1 * size)
+        throw InputError(where + ": " + key + " is " + io::format_number(distance) + " m from the nearest node of the sector (" +
+                         "model size " + io::format_number(size) + " m): give a point on the sector");
+    }
+  }
   forcing.damping_ratio = c.modal.damping_ratio;
   forcing.residual_flexibility = c.modal.residual_flexibility;
   log::Stopwatch clock;

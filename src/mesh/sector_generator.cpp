@@ -36,7 +36,10 @@ double blade_half_z(const SectorGeometry& g, double phi) {
 std::vector<std::pair<std::string, std::string>> SectorGeometry::validate() const {
   std::vector<std::pair<std::string, std::string>> v;
   auto add = [&](const char* key, const std::string& what) { v.emplace_back(std::string("geometry.") + key, what); };
-  if (sectors < 2) v.emplace_back("structure.sectors", "sectors >= 2 for a generated sector");
+  // A 180-degree sector (Nb = 2) has both radial sides on one plane through the axis, which
+  // the contact-plane trimming below (half-spaces through the axis) cannot tell apart: Nb = 2
+  // needs a mesh of one's own ([structure] mesh), which the cyclic reduction handles.
+  if (sectors < 3) v.emplace_back("structure.sectors", "sectors >= 3 for a generated sector (Nb = 2: give [structure] mesh)");
   if (v.size()) return v;
   const double alpha = alpha_of(*this);
   if (disk_outer_radius <= hub_radius) add("disk_outer_radius", "disk_outer_radius > hub_radius");
@@ -263,11 +266,15 @@ GenerateReport generate_sector_mesh(const SectorGeometry& g, const std::filesyst
       const double rc = std::hypot(cx, cy);
       const bool on_hub = std::all_of(pts.begin(), pts.end(),
                                       [&](const Eigen::Vector3d& p) { return std::abs(std::hypot(p.x(), p.y()) - g.hub_radius) < tol; });
+      // Which side: the face lies along the ray at theta_low or theta_high (for Nb = 2 both
+      // radial sides are on one plane through the axis, so the plane alone cannot tell).
+      const Eigen::Vector3d c(cx, cy, 0.0);
+      const bool low_side = c.dot(e_r(theta_low)) > 0, high_side = c.dot(e_r(theta_high)) > 0;
       if (on_hub) hub.push_back(tag);
-      else if (rc < r_split && all_on_plane(pts, e_t(theta_low), tol)) cyc_low.push_back(tag);
-      else if (rc < r_split && all_on_plane(pts, e_t(theta_high), tol)) cyc_high.push_back(tag);
-      else if (rc > r_split && all_on_plane(pts, n_low, tol)) sh_low.push_back(tag);
-      else if (rc > r_split && all_on_plane(pts, n_high, tol)) sh_high.push_back(tag);
+      else if (rc < r_split && low_side && all_on_plane(pts, e_t(theta_low), tol)) cyc_low.push_back(tag);
+      else if (rc < r_split && high_side && all_on_plane(pts, e_t(theta_high), tol)) cyc_high.push_back(tag);
+      else if (rc > r_split && low_side && all_on_plane(pts, n_low, tol)) sh_low.push_back(tag);
+      else if (rc > r_split && high_side && all_on_plane(pts, n_high, tol)) sh_high.push_back(tag);
     }
     auto need = [](const std::vector<int>& v, const char* what) {
       if (v.empty()) throw NumericalError(std::string("gmsh: no surface found for ") + what);

@@ -260,6 +260,57 @@ TEST(Cli, ConvergenceStudyTabulatesEveryKnobAgainstItsFinestValue) {
   EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "case" / "frf.csv"));
 }
 
+TEST(Cli, SectorCountExtremes) {
+  // Nb = 100: a thin 3.6-degree sector on a 1 m hub runs end to end (mesh, modes of the
+  // harmonic indices EO 1 reaches, forced response) with every value finite.
+  const Scratch s("nb100");
+  s.write("case.toml", R"(name = "nb100"
+[structure]
+sectors = 100
+[geometry]
+hub_radius = 1.0
+disk_outer_radius = 1.04
+blade_chord = 0.04
+blade_twist_deg = 10.0
+shroud_width = 0.05
+element_order = 1
+mesh_size = 0.02
+[modal]
+modes = 10
+[excitation]
+point = [0.0, 1.28, 0.0]
+[response]
+point = [0.0, 1.27, 0.0]
+[contact]
+pairs = 3
+[hbm]
+harmonics = 3
+time_samples = 128
+[continuation]
+frequency_start_hz = 100.0
+frequency_end_hz = 200.0
+initial_step = 0.5
+)");
+  const CliResult r = s.run("run case.toml --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto run = nlohmann::json::parse(slurp(s.dir() / "results" / "nb100" / "run.json"));
+  EXPECT_EQ(run.at("frf").at("status"), "reached_end");
+  EXPECT_GT(run.at("frf").at("peak_amplitude_m").get<double>(), 0.0);
+  for (const auto& l : lines_of(slurp(s.dir() / "results" / "nb100" / "frf.csv"))) {
+    EXPECT_EQ(l.find("nan"), std::string::npos) << l;
+    EXPECT_EQ(l.find("inf"), std::string::npos) << l;
+  }
+  // A point whose nearest node is clamped would answer zero: refused, naming the key.
+  const CliResult hub = s.run("frf case.toml --quiet --set excitation.point=[0.0,1.0,0.0]");
+  EXPECT_EQ(hub.status, kBadInput) << hub.err;
+  EXPECT_NE(hub.err.find("excitation.point"), std::string::npos) << hub.err;
+  EXPECT_NE(hub.err.find("clamped"), std::string::npos) << hub.err;
+  // Nb = 2 is refused by the generator with the reason (a user mesh serves it).
+  const CliResult two = s.run("mesh case.toml --quiet --set structure.sectors=2");
+  EXPECT_EQ(two.status, kBadInput) << two.err;
+  EXPECT_NE(two.err.find("structure.sectors"), std::string::npos) << two.err;
+}
+
 TEST(Cli, ContinuationThatCannotFinishExitsThreeWithWhatItHas) {
   const Scratch s("frf3");
   s.write("case.toml", kLumpedCase);
