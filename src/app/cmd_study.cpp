@@ -113,7 +113,7 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
 /// the case's own setting, each against its finest value (the reference), with every other
 /// knob at the case's setting. The error of a point is peaks_change (frf_curves.hpp) between
 /// its curve and the reference's (the largest relative change at any resonance peak of the
-/// range) and the shift of the largest peak's frequency; its cost is its wall time (a run
+/// range) and peaks_shift_hz (the largest shift of such a peak); its cost is its wall time (a run
 /// that has to build a new mesh and its modes pays for them). -> trade.csv, trade.png.
 int run_convergence(Context& ctx) {
   const io::Case& c = ctx.config;
@@ -191,17 +191,19 @@ int run_convergence(Context& ctx) {
     std::string value;
   };
   std::vector<Row> rows;
+  std::vector<std::string> reference_label(knobs.size());
   try {
     for (std::size_t k = 0; k < knobs.size(); ++k) {
+      // Every value at the case's other settings; the reference is the finest value, with
+      // the knob's extra overrides (e.g. more samples for more harmonics) when it has some,
+      // listed as a row of its own.
       auto ref = knobs[k].reference;
       ref.emplace_back(knobs[k].key, knobs[k].values.back());
       const std::size_t r = point_of(ref);
-      for (const auto& v : knobs[k].values) {
-        auto values = knobs[k].reference;
-        if (v != knobs[k].values.back()) values.clear();  // coarser values at the case's other settings
-        values.emplace_back(knobs[k].key, v);
-        rows.push_back({k, point_of(values), r, v});
-      }
+      reference_label[k] = knobs[k].values.back();
+      for (const auto& [key, value] : knobs[k].reference) reference_label[k] += " " + key + "=" + value;
+      for (const auto& v : knobs[k].values) rows.push_back({k, point_of({{knobs[k].key, v}}), r, v});
+      if (!knobs[k].reference.empty()) rows.push_back({k, r, r, reference_label[k]});
     }
   } catch (const InputError& e) {
     throw InputError(c.file.string() + ": study --convergence: a varied value is not valid for this case: " + e.what());
@@ -225,10 +227,11 @@ int run_convergence(Context& ctx) {
     const bool ok = p.status == 0 && r.status == 0;
     double err = 0.0, ferr = 0.0;
     if (ok) {
-      err = peaks_change(read_curve(ctx.out_dir / p.folder / "frf.csv"), read_curve(ctx.out_dir / r.folder / "frf.csv"));
-      ferr = std::abs(p.peak_frequency - r.peak_frequency);
+      const auto cp = read_curve(ctx.out_dir / p.folder / "frf.csv"), cr = read_curve(ctx.out_dir / r.folder / "frf.csv");
+      err = peaks_change(cp, cr);
+      ferr = peaks_shift_hz(cp, cr);
     }
-    std::string value = row.value, ref = knobs[row.knob].values.back();
+    std::string value = row.value, ref = reference_label[row.knob];
     for (std::string* t : {&value, &ref}) t->erase(std::remove(t->begin(), t->end(), '"'), t->end());
     csv << knobs[row.knob].name << "," << knobs[row.knob].key << "," << value << "," << ref << ","
         << (p.status == 0 ? "ok" : "failed") << "," << num(p.seconds) << "," << p.points << "," << num(p.peak) << ","

@@ -22,4 +22,8 @@ std::vector<std::pair<double, double>> read_curve(const std::filesystem::path& f
 /// peak. 1 when a peak has no counterpart at all.
 double peaks_change(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b);
 
+/// The largest shift [Hz] of a resonance peak between two curves, over the same peaks as
+/// peaks_change (the frequency of each curve's window peak).
+double peaks_shift_hz(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b);
+
 }  // namespace shroudsim::app
