@@ -106,10 +106,16 @@ int cmd_campbell(Context& ctx) {
   canonical.erase(std::unique(canonical.begin(), canonical.end()), canonical.end());
   std::map<int, Sweep> sweeps;
   for (int h : canonical) sweeps[h].f.assign(np, Eigen::VectorXd());
+  // Frequencies at rest of canonical h (from h or from Nb - h: equal spectra).
+  auto at_rest = [&](int h) {
+    auto it = model.bases.find(h);
+    if (it == model.bases.end()) it = model.bases.find((nb - h) % nb);
+    return it->second.frequency_hz();
+  };
 
   if (!rotating) {
     for (int h : canonical)
-      for (int i = 0; i < np; ++i) sweeps[h].f[i] = model.bases.at(h).frequency_hz();
+      for (int i = 0; i < np; ++i) sweeps[h].f[i] = at_rest(h);
   } else {
     // Centrifugal prestress (h = 0 static solve) and the reduction of K_sigma1, M_spin.
     log::Stopwatch watch;
@@ -141,7 +147,7 @@ int cmd_campbell(Context& ctx) {
           modal::RotatingHarmonic hr(sector, rot, h);
           for (int i = 0; i < np; ++i) {
             if (rpm[i] == 0.0) {  // K(0) = K: the modes at rest
-              s.f[i] = model.bases.at(h).frequency_hz();
+              s.f[i] = at_rest(h);
               continue;
             }
             log::Stopwatch solve_clock;
