@@ -1,5 +1,6 @@
 // `shroudsim campbell`: natural frequencies against speed with engine-order lines ->
-// campbell.csv, crossings.csv (and modes.csv, campbell.png, nd_map.png).
+// campbell.csv, crossings.csv (and modes.csv, campbell.png, nd_map.png; with rotating effects
+// also prestress.vtu: the centrifugal displacement and von Mises stress at the top speed).
 //
 // Speeds: campbell.speed_points values evenly spaced over campbell.speed_rpm = [s0, s1].
 // - rotating_effects = false: the frequencies at rest at every speed (flat lines).
@@ -130,6 +131,15 @@ int cmd_campbell(Context& ctx) {
     report["peak_von_mises_pa_at_top_speed"] = peak_top;
     report["peak_von_mises_element"] = ops.peak.element;
     report["max_static_displacement_m_at_top_speed"] = tip_top;
+    {
+      // The prestress at the top speed for ParaView: displacement and nodal von Mises stress.
+      const double w2 = omega_top * omega_top;
+      Eigen::MatrixXd disp(model.mesh.n_nodes(), 3);
+      for (int n = 0; n < model.mesh.n_nodes(); ++n) disp.row(n) = w2 * ops.displacement.segment<3>(3 * n).transpose();
+      const Eigen::VectorXd vm = w2 * fe::nodal_von_mises(model.mesh, model.material, ops.displacement);
+      write_point_fields_vtu(ctx, model.mesh, "prestress.vtu",
+                             {{"centrifugal_displacement_m", disp}, {"von_mises_pa", Eigen::MatrixXd(vm)}});
+    }
     log::info("campbell: centrifugal prestress at " + io::format_number(s1) + " rpm: peak von Mises " +
               fixed(peak_top / 1e6, 1) + " MPa (element " + std::to_string(ops.peak.element) +
               "), largest displacement " + fixed(tip_top * 1e3, 3) + " mm (" + fixed(prestress_seconds, 2) + " s)");

@@ -344,11 +344,59 @@ std::string vtk_binary(const std::vector<T>& values) {
   return base64(buf);
 }
 
+// The VTU tail after the point data: points, cells (4- or 10-node tets), closing tags.
+std::string vtu_points_and_cells(const mesh::Mesh& m) {
+  const int npe = m.nodes_per_element();
+  std::ostringstream s;
+  s << "</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">\n";
+  std::vector<double> xyz(m.nodes.data(), m.nodes.data() + m.nodes.size());  // row-major n x 3
+  s << vtk_binary(xyz) << "\n</DataArray>\n</Points>\n<Cells>\n";
+  // VTK quadratic tetra: edges (0,1) (1,2) (0,2) (0,3) (1,3) (2,3); gmsh: ... (2,3) (1,3).
+  static constexpr int kGmshToVtk10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
+  std::vector<std::int32_t> conn, offsets;
+  std::vector<std::uint8_t> types;
+  for (int e = 0; e < m.n_elements(); ++e) {
+    for (int a = 0; a < npe; ++a) conn.push_back(m.tets(e, npe == 10 ? kGmshToVtk10[a] : a));
+    offsets.push_back(static_cast<std::int32_t>(conn.size()));
+    types.push_back(npe == 10 ? 24 : 10);
+  }
+  s << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"binary\">\n" << vtk_binary(conn) << "\n</DataArray>\n"
+    << "<DataArray type=\"Int32\" Name=\"offsets\" format=\"binary\">\n" << vtk_binary(offsets) << "\n</DataArray>\n"
+    << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n" << vtk_binary(types) << "\n</DataArray>\n"
+    << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  return s.str();
+}
+
+std::string vtu_head(const mesh::Mesh& m) {
+  std::ostringstream s;
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+       "header_type=\"UInt32\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
+    << m.n_nodes() << "\" NumberOfCells=\"" << m.n_elements() << "\">\n<PointData>\n";
+  return s.str();
+}
+
 }  // namespace
+
+void write_point_fields_vtu(Context& ctx, const mesh::Mesh& mesh, const std::string& file,
+                            const std::vector<PointField>& fields) {
+  std::ostringstream s;
+  s << vtu_head(mesh);
+  for (const auto& f : fields) {
+    SHROUDSIM_CHECK(f.values.rows() == mesh.n_nodes() && (f.values.cols() == 1 || f.values.cols() == 3),
+                    "write_point_fields_vtu: a field needs n_nodes rows and 1 or 3 columns");
+    std::vector<float> v;
+    v.reserve(f.values.size());
+    for (Eigen::Index n = 0; n < f.values.rows(); ++n)
+      for (Eigen::Index c = 0; c < f.values.cols(); ++c) v.push_back(static_cast<float>(f.values(n, c)));
+    s << "<DataArray type=\"Float32\" Name=\"" << f.name << "\" NumberOfComponents=\"" << f.values.cols()
+      << "\" format=\"binary\">\n" << vtk_binary(v) << "\n</DataArray>\n";
+  }
+  s << vtu_points_and_cells(mesh);
+  io::write_file_atomic(ctx.out_dir / file, s.str());
+}
 
 void write_modes_vtu(Context& ctx, ModalModel& model) {
   const mesh::Mesh& m = model.mesh;
-  const int npe = m.nodes_per_element();
   // Field budget: at most 256 MiB of float32 point data.
   const double per_field = 12.0 * m.n_nodes();
   const int max_fields = std::max(1, static_cast<int>(256.0 * 1024 * 1024 / per_field));
@@ -360,9 +408,7 @@ void write_modes_vtu(Context& ctx, ModalModel& model) {
                     " modes of each harmonic index (file size limit of 256 MiB)");
 
   std::ostringstream s;
-  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-       "header_type=\"UInt32\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
-    << m.n_nodes() << "\" NumberOfCells=\"" << m.n_elements() << "\">\n<PointData>\n";
+  s << vtu_head(m);
   const cyclic::CyclicSector& sector = model.cyclic();
   for (const auto& [h, b] : model.bases) {
     const Eigen::VectorXd f = b.frequency_hz();
@@ -380,22 +426,7 @@ void write_modes_vtu(Context& ctx, ModalModel& model) {
         << "Hz\" NumberOfComponents=\"3\" format=\"binary\">\n" << vtk_binary(v) << "\n</DataArray>\n";
     }
   }
-  s << "</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">\n";
-  std::vector<double> xyz(m.nodes.data(), m.nodes.data() + m.nodes.size());  // row-major n x 3
-  s << vtk_binary(xyz) << "\n</DataArray>\n</Points>\n<Cells>\n";
-  // VTK quadratic tetra: edges (0,1) (1,2) (0,2) (0,3) (1,3) (2,3); gmsh: ... (2,3) (1,3).
-  static constexpr int kGmshToVtk10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
-  std::vector<std::int32_t> conn, offsets;
-  std::vector<std::uint8_t> types;
-  for (int e = 0; e < m.n_elements(); ++e) {
-    for (int a = 0; a < npe; ++a) conn.push_back(m.tets(e, npe == 10 ? kGmshToVtk10[a] : a));
-    offsets.push_back(static_cast<std::int32_t>(conn.size()));
-    types.push_back(npe == 10 ? 24 : 10);
-  }
-  s << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"binary\">\n" << vtk_binary(conn) << "\n</DataArray>\n"
-    << "<DataArray type=\"Int32\" Name=\"offsets\" format=\"binary\">\n" << vtk_binary(offsets) << "\n</DataArray>\n"
-    << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n" << vtk_binary(types) << "\n</DataArray>\n"
-    << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  s << vtu_points_and_cells(m);
   io::write_file_atomic(ctx.out_dir / "modes.vtu", s.str());
 }
 

@@ -195,6 +195,43 @@ PeakStress peak_von_mises(const mesh::Mesh& mesh, const Material& material, cons
   return mesh.nodes_per_element() == 4 ? peak_range<4>(mesh, material, u) : peak_range<10>(mesh, material, u);
 }
 
+namespace {
+template <int NPE>
+Eigen::VectorXd nodal_range(const mesh::Mesh& mesh, const Material& material, const Eigen::VectorXd& u) {
+  // Reference coordinates of the nodes (gmsh order: vertices, then edge midpoints).
+  static const std::vector<Eigen::Matrix<double, NPE, 3>> node_dn = [] {
+    const double ref[10][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.5, 0, 0},
+                               {0.5, 0.5, 0}, {0, 0.5, 0}, {0, 0, 0.5}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
+    std::vector<Eigen::Matrix<double, NPE, 3>> v;
+    for (int a = 0; a < NPE; ++a) v.push_back(TetShape<NPE>::gradients(Eigen::Vector3d(ref[a][0], ref[a][1], ref[a][2])));
+    return v;
+  }();
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(mesh.n_nodes()), count = sum;
+  ElementNodes<NPE> X;
+  ElementVector<NPE> ue;
+  Eigen::Matrix<double, NPE, 3> G;
+  for (int e = 0; e < mesh.n_elements(); ++e) {
+    for (int a = 0; a < NPE; ++a) {
+      const int n = mesh.tets(e, a);
+      X.row(a) = mesh.nodes.row(n);
+      ue.template segment<3>(3 * a) = u.segment<3>(3 * n);
+    }
+    for (int a = 0; a < NPE; ++a) {
+      double det = 0.0;
+      if (!physical_gradients<NPE>(X, node_dn[a], G, det)) continue;
+      sum(mesh.tets(e, a)) += von_mises(stress_from_gradients<NPE>(material, G, ue));
+      count(mesh.tets(e, a)) += 1.0;
+    }
+  }
+  return sum.cwiseQuotient(count.cwiseMax(1.0));
+}
+}  // namespace
+
+Eigen::VectorXd nodal_von_mises(const mesh::Mesh& mesh, const Material& material, const Eigen::VectorXd& u) {
+  SHROUDSIM_CHECK(u.size() == mesh.n_dofs(), "nodal_von_mises: u does not match the mesh");
+  return mesh.nodes_per_element() == 4 ? nodal_range<4>(mesh, material, u) : nodal_range<10>(mesh, material, u);
+}
+
 template bool tet_stress<4>(const ElementNodes<4>&, const Material&, const ElementVector<4>&, const Eigen::Vector3d&,
                             Eigen::Matrix3d&);
 template bool tet_stress<10>(const ElementNodes<10>&, const Material&, const ElementVector<10>&,

@@ -81,6 +81,10 @@ struct PeakStress {
 };
 PeakStress peak_von_mises(const mesh::Mesh& mesh, const Material& material, const Eigen::VectorXd& u);
 
+/// Von Mises stress [Pa] of u at every node: the average over the elements sharing the node of
+/// each element's stress at that node (for plots; the stress is discontinuous between elements).
+Eigen::VectorXd nodal_von_mises(const mesh::Mesh& mesh, const Material& material, const Eigen::VectorXd& u);
+
 extern template bool tet_stress<4>(const ElementNodes<4>&, const Material&, const ElementVector<4>&,
                                    const Eigen::Vector3d&, Eigen::Matrix3d&);
 extern template bool tet_stress<10>(const ElementNodes<10>&, const Material&, const ElementVector<10>&,

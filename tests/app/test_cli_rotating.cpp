@@ -77,6 +77,9 @@ TEST(CliRotating, CampbellFrequenciesDependOnSpeedAndCrossingsLieOnTheEngineOrde
   }
   const std::string run = slurp(s.dir() / "results" / "coarse" / "run.json");
   EXPECT_NE(run.find("\"rotating_effects\": true"), std::string::npos);
+  const std::string vtu = slurp(s.dir() / "results" / "coarse" / "prestress.vtu");
+  EXPECT_NE(vtu.find("Name=\"von_mises_pa\""), std::string::npos);
+  EXPECT_NE(vtu.find("Name=\"centrifugal_displacement_m\""), std::string::npos);
   EXPECT_NE(run.find("\"symbolic_analyses\": 1"), std::string::npos);  // one analysis per harmonic index
 }
 
