@@ -7,6 +7,7 @@
 // (run_convergence below) -> trade.csv, trade.png; it needs no [study] section.
 #include <algorithm>
 #include <atomic>
+#include <ctime>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -31,6 +32,7 @@ struct StudyPoint {
   int status = -1;
   std::string message;
   double peak = 0.0, peak_frequency = 0.0, seconds = 0.0;
+  double cpu_seconds = 0.0;  ///< CPU time of the point's own thread (points run with threads = 1)
   std::size_t points = 0;
 };
 
@@ -44,6 +46,14 @@ std::string folder_name(const std::vector<std::pair<std::string, std::string>>& 
     s += (s.empty() ? "" : "__") + key + "=" + val;
   }
   return s;
+}
+
+/// CPU time of the calling thread [s]: the cost of a study point whatever else the machine
+/// (or the other workers) is doing.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 /// Runs every point (the case `cases[i]` into <out>/<points[i].folder>) on --threads workers,
@@ -65,6 +75,7 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
       pc.threads = 1;
       pc.plots = false;
       log::Stopwatch clock;
+      const double cpu0 = thread_cpu_seconds();
       StudyPoint& p = points[i];
       try {
         p.status = cmd_run(pc);
@@ -76,6 +87,7 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
         p.status = 1, p.message = e.what();
       }
       p.seconds = clock.seconds();
+      p.cpu_seconds = thread_cpu_seconds() - cpu0;
       const auto& j = pc.report.json();
       if (j.contains("frf")) {
         p.peak = j["frf"].value("peak_amplitude_m", 0.0);
@@ -219,7 +231,7 @@ int run_convergence(Context& ctx) {
 
   std::ostringstream csv;
   csv << "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,peaks_error,"
-         "peak_frequency_error_hz,folder\n";
+         "peak_frequency_error_hz,folder,cpu_seconds\n";
   int failed = 0;
   for (const auto& row : rows) {
     const StudyPoint& p = points[row.point];
@@ -235,7 +247,7 @@ int run_convergence(Context& ctx) {
     for (std::string* t : {&value, &ref}) t->erase(std::remove(t->begin(), t->end(), '"'), t->end());
     csv << knobs[row.knob].name << "," << knobs[row.knob].key << "," << value << "," << ref << ","
         << (p.status == 0 ? "ok" : "failed") << "," << num(p.seconds) << "," << p.points << "," << num(p.peak) << ","
-        << num(p.peak_frequency) << "," << (ok ? num(err) : "") << "," << (ok ? num(ferr) : "") << "," << p.folder << "\n";
+        << num(p.peak_frequency) << "," << (ok ? num(err) : "") << "," << (ok ? num(ferr) : "") << "," << p.folder << "," << num(p.cpu_seconds) << "\n";
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());

@@ -231,14 +231,14 @@ TEST(Cli, ConvergenceStudyTabulatesEveryKnobAgainstItsFinestValue) {
   const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "trade.csv"));
   ASSERT_GT(lines.size(), 1u);
   EXPECT_EQ(lines[0], "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,"
-                      "peaks_error,peak_frequency_error_hz,folder");
+                      "peaks_error,peak_frequency_error_hz,folder,cpu_seconds");
   // Rows per knob, in the order coarse to fine: (value, error).
   std::map<std::string, std::vector<std::pair<std::string, double>>> knobs;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     std::vector<std::string> f;
     std::istringstream row(lines[i]);
     for (std::string x; std::getline(row, x, ',');) f.push_back(x);
-    ASSERT_EQ(f.size(), 12u) << lines[i];
+    ASSERT_EQ(f.size(), 13u) << lines[i];
     EXPECT_EQ(f[4], "ok") << lines[i];
     knobs[f[1]].emplace_back(f[2], std::stod(f[9]));
     if (f[2] == f[3]) {

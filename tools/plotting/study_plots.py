@@ -57,6 +57,9 @@ def plot_trade(result_dir):
         rows = [r for r in csv.DictReader(f) if r["status"] == "ok" and r["peaks_error"] != ""]
     if not rows:
         return
+    def cost(r):  # CPU time of the run's thread where recorded (load-independent), else wall time
+        return float(r.get("cpu_seconds") or r["seconds"])
+
     knobs = []
     for r in rows:
         if r["knob"] not in knobs:
@@ -68,15 +71,15 @@ def plot_trade(result_dir):
     for i, k in enumerate(knobs):
         sel = [r for r in rows if r["knob"] == k]
         ref = next((r for r in sel if float(r["peaks_error"]) == 0), None)
-        xs = [float(r["seconds"]) for r in sel if float(r["peaks_error"]) > 0]
+        xs = [cost(r) for r in sel if float(r["peaks_error"]) > 0]
         ys = [float(r["peaks_error"]) for r in sel if float(r["peaks_error"]) > 0]
-        label = k + (f" (reference {ref['value']}: {float(ref['seconds']):.3g} s)" if ref else "")
+        label = k + (f" (reference {ref['value']}: {cost(ref):.3g} s)" if ref else "")
         ax.loglog(xs, ys, markers[i % len(markers)], ls="-", lw=0.8, label=label)
         for r in sel:
             if float(r["peaks_error"]) > 0:
-                ax.annotate(r["value"], (float(r["seconds"]), float(r["peaks_error"])), fontsize=7,
+                ax.annotate(r["value"], (cost(r), float(r["peaks_error"])), fontsize=7,
                             textcoords="offset points", xytext=(4, 3))
-                pts.append((float(r["seconds"]), float(r["peaks_error"])))
+                pts.append((cost(r), float(r["peaks_error"])))
     pts.sort()
     front, best = [], float("inf")
     for x, y in pts:
@@ -87,7 +90,7 @@ def plot_trade(result_dir):
         ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="0.5", lw=0.8, ls=":",
                 label="Pareto front")
     ax.set_ylim(bottom=floor)
-    ax.set_xlabel("wall time of the run [s]")
+    ax.set_xlabel("CPU time of the run [s]")
     ax.set_ylabel("largest relative change of a resonance peak vs the knob's reference")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
