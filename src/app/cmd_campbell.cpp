@@ -23,6 +23,7 @@
 // line). For flat lines this is exactly rpm = 60 f_r / e.
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -172,14 +173,19 @@ int cmd_campbell(Context& ctx) {
                           (r.report.status == modal::ModalStatus::FactorizationFailed
                                ? " (K + K_sigma - Omega^2 M_spin is not positive definite: a mode diverges)"
                                : "");
-              // Where: the lowest f^2 extrapolated linearly in Omega^2 to zero from the last two speeds.
-              if (i >= 2 && s.f[i - 1].size() > 0 && s.f[i - 2].size() > 0) {
-                const double fa = s.f[i - 2](0), fb = s.f[i - 1](0);
-                const double wa = rpm[i - 2] * rpm[i - 2], wb = rpm[i - 1] * rpm[i - 1];
-                s.failure += "; mode 1 is " + fixed(fb, 1) + " Hz at " + io::format_number(rpm[i - 1]) + " rpm";
-                if (fb < fa)
-                  s.failure += ", extrapolated to 0 Hz near " +
-                               fixed(std::sqrt(wb + (0.0 - fb * fb) * (wb - wa) / (fb * fb - fa * fa)), 0) + " rpm";
+              // Where: between the last converged speed and this one; the lowest f^2 extrapolated
+              // linearly in Omega^2 from the last two speeds, when that lands in between.
+              if (i >= 1 && s.f[i - 1].size() > 0) {
+                const double fb = s.f[i - 1](0);
+                s.failure += "; the lowest mode is " + fixed(fb, 1) + " Hz at " + io::format_number(rpm[i - 1]) +
+                             " rpm and diverges below " + io::format_number(rpm[i]) + " rpm";
+                if (i >= 2 && s.f[i - 2].size() > 0 && fb < s.f[i - 2](0)) {
+                  const double fa = s.f[i - 2](0);
+                  const double wa = rpm[i - 2] * rpm[i - 2], wb = rpm[i - 1] * rpm[i - 1];
+                  const double at = std::sqrt(wb + (0.0 - fb * fb) * (wb - wa) / (fb * fb - fa * fa));
+                  if (at > rpm[i - 1] && at < rpm[i])
+                    s.failure += " (f^2 extrapolated to 0 near " + fixed(at, 0) + " rpm)";
+                }
               }
               break;
             }
@@ -286,7 +292,12 @@ int cmd_campbell(Context& ctx) {
             io::format_number(s0) + ", " + io::format_number(s1) + "] rpm" +
             (rotating ? " (rotating effects)" : " (frequencies at rest)"));
 
-  draw_plots(ctx);  // what converged is drawn even when a sweep failed
+  // What converged is drawn even when a sweep failed. run.json (where tools/plot.py reads why
+  // a sweep stopped) is written after the command returns, so the plot of this run gets the
+  // reason from the environment of the plotting process.
+  if (!model.failures.empty())
+    ::setenv("SHROUDSIM_CAMPBELL_STOPPED", model.failures.front().c_str(), 1);
+  draw_plots(ctx);
   if (!model.failures.empty()) {
     std::string msg = "modal analysis failed for";
     for (const auto& f : model.failures) msg += "\n  " + f;

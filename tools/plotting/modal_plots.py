@@ -95,13 +95,16 @@ def plot_campbell(result_dir):
     if crossings:
         ax.plot([float(c["speed_rpm"]) for c in crossings], [float(c["frequency_hz"]) for c in crossings],
                 "ro", mfc="none", ms=7, label="crossing (EO excites ND)")
-    # A sweep that stopped (a mode diverged): say where, from run.json.
-    try:
-        with open(os.path.join(result_dir, "run.json")) as f:
-            sweeps = json.load(f).get("campbell", {}).get("sweeps", [])
-        failures = [w["failure"] for w in sweeps if "failure" in w]
-    except (OSError, ValueError):
-        failures = []
+    # A sweep that stopped (a mode diverged): say where, from run.json (or, while shroudsim
+    # itself draws, before it writes run.json, from SHROUDSIM_CAMPBELL_STOPPED).
+    failures = [os.environ["SHROUDSIM_CAMPBELL_STOPPED"]] if os.environ.get("SHROUDSIM_CAMPBELL_STOPPED") else []
+    if not failures:
+        try:
+            with open(os.path.join(result_dir, "run.json")) as f:
+                sweeps = json.load(f).get("campbell", {}).get("sweeps", [])
+            failures = [w["failure"] for w in sweeps if "failure" in w]
+        except (OSError, ValueError):
+            failures = []
     if failures:
         why = ("a mode diverges (K + K_sigma - Omega^2 M_spin not positive definite)"
                if "not positive definite" in failures[0] else failures[0][:90])
