@@ -295,7 +295,8 @@ int cmd_campbell(Context& ctx) {
   // What converged is drawn even when a sweep failed. run.json (where tools/plot.py reads why
   // a sweep stopped) is written after the command returns, so the plot of this run gets the
   // reason from the environment of the plotting process.
-  if (!model.failures.empty())
+  // (Only when this command plots: study points run in threads and never plot.)
+  if (ctx.plots && !model.failures.empty())
     ::setenv("SHROUDSIM_CAMPBELL_STOPPED", model.failures.front().c_str(), 1);
   draw_plots(ctx);
   if (!model.failures.empty()) {
