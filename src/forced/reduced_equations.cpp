@@ -5,10 +5,13 @@
 #include <numbers>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 
 namespace shroudsim::forced {
 namespace {
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
+/// Largest Jacobian (entries) kept as a copy for repeated evaluations (64 MB).
+constexpr double kCopyLimit = 8.0e6;
 
 /// max over theta of |Re sum_n U_n exp(i n theta)|: sampled on `samples` points, then the
 /// best sample refined by golden-section search (the sampled maximum alone is low by up to
@@ -99,48 +102,279 @@ void ReducedEquations::assemble(double frequency_hz, Eigen::MatrixXd& g, Eigen::
   }
 }
 
-bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r,
-                                Eigen::MatrixXd* J, Eigen::VectorXd*) {
-  if (!w.allFinite() || !std::isfinite(frequency_hz) || frequency_hz <= 0) return false;
-  Eigen::MatrixXd g;
-  Eigen::VectorXd w_lin;
-  assemble(frequency_hz, g, &w_lin);
-  contacts_.evaluate(w, f_, J ? &blocks_ : nullptr);
-  r = w - excitation_scale_ * w_lin + g * f_;
-  if (J) {
-    const int block = contacts_.pair_layout().size();
-    J->setIdentity(size(), size());
-    for (int p = 0; p < contacts_.n_pairs(); ++p)
-      J->middleCols(p * block, block).noalias() += g.middleCols(p * block, block) * blocks_[static_cast<std::size_t>(p)];
+void ReducedEquations::add_harmonic(const Eigen::VectorXcd& z, int n, Eigen::VectorXd& out) const {
+  for (int p = 0; p < contacts_.n_pairs(); ++p)
+    for (int d = 0; d < n_directions_; ++d) {
+      const std::complex<double> v = z[3 * p + d];
+      out[index(p, d, n, false)] += v.real();
+      if (n > 0) out[index(p, d, n, true)] -= v.imag();
+    }
+}
+
+const ReducedEquations::Harmonics& ReducedEquations::harmonics(double frequency_hz, bool derivative) {
+  if (harmonics_.frequency_hz == frequency_hz && (!derivative || harmonics_.derivative)) return harmonics_;
+  log::Stopwatch clock;
+  const int h = contacts_.pair_layout().n_harmonics();
+  const double w = kTwoPi * frequency_hz;
+  if (harmonics_.frequency_hz != frequency_hz) {
+    harmonics_.g.resize(h + 1);
+    harmonics_.w_lin.resize(h + 1);
+    frf::HarmonicReceptance rec;
+    for (int n = 0; n <= h; ++n) {
+      linear_.harmonic(n, w, rec);
+      harmonics_.g[n] = std::move(rec.G);
+      harmonics_.w_lin[n] = std::move(rec.w_lin);
+    }
+    harmonics_.frequency_hz = frequency_hz;
+    harmonics_.derivative = false;
   }
-  return r.allFinite() && (!J || J->allFinite());
+  if (derivative) {
+    harmonics_.dg.resize(h + 1);
+    harmonics_.dw_lin.resize(h + 1);
+    for (int n = 0; n <= h; ++n) linear_.harmonic_derivative(n, w, harmonics_.dg[n], harmonics_.dw_lin[n]);
+    harmonics_.derivative = true;
+  }
+  stats_.receptance_seconds += clock.seconds();
+  return harmonics_;
+}
+
+void ReducedEquations::apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const {
+  out.setZero(size());
+  for (std::size_t n = 0; n < m.size(); ++n) add_harmonic(m[n] * complex_harmonic(v, static_cast<int>(n)), static_cast<int>(n), out);
+}
+
+void ReducedEquations::jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks, Eigen::MatrixXd& J) {
+  const Harmonics& hs = harmonics(frequency_hz, false);
+  log::Stopwatch clock;
+  const auto& layout = contacts_.pair_layout();
+  const int h = layout.n_harmonics(), pairs = contacts_.n_pairs(), block = layout.size(), nd = n_directions_;
+  J.setIdentity(size(), size());
+  Eigen::MatrixXd gr, dsub, prod;
+  std::vector<int> rows;
+  for (int n = 0; n <= h; ++n) {
+    const int parts = n == 0 ? 1 : 2, per_pair = nd * parts, m = pairs * per_pair;
+    // Real form of G_n in the harmonic-local order (pair, direction, part) and the global
+    // row of each local index.
+    gr.resize(m, m);
+    rows.resize(static_cast<std::size_t>(m));
+    const Eigen::MatrixXcd& g = hs.g[static_cast<std::size_t>(n)];
+    for (int q = 0; q < pairs; ++q)
+      for (int e = 0; e < nd; ++e) {
+        const int lq = (q * nd + e) * parts;
+        rows[static_cast<std::size_t>(lq)] = index(q, e, n, false);
+        if (n > 0) rows[static_cast<std::size_t>(lq + 1)] = index(q, e, n, true);
+        for (int p = 0; p < pairs; ++p)
+          for (int d = 0; d < nd; ++d) {
+            const int lp = (p * nd + d) * parts;
+            const std::complex<double> gij = g(3 * p + d, 3 * q + e);
+            if (n == 0) {
+              gr(lp, lq) = gij.real();
+            } else {
+              gr(lp, lq) = gij.real();
+              gr(lp, lq + 1) = gij.imag();
+              gr(lp + 1, lq) = -gij.imag();
+              gr(lp + 1, lq + 1) = gij.real();
+            }
+          }
+      }
+    dsub.resize(per_pair, block);
+    for (int q = 0; q < pairs; ++q) {
+      const Eigen::MatrixXd& dq = blocks[static_cast<std::size_t>(q)];
+      // Rows of harmonic n of D_q, in the local order (direction, part).
+      for (int e = 0; e < nd; ++e) {
+        dsub.row(e * parts) = dq.row(layout.index(e, n, hbm::HarmonicLayout::Part::cosine));
+        if (n > 0) dsub.row(e * parts + 1) = dq.row(layout.index(e, n, hbm::HarmonicLayout::Part::sine));
+      }
+      prod.noalias() = gr.middleCols(q * per_pair, per_pair) * dsub;
+      for (int col = 0; col < block; ++col) {
+        double* jc = J.col(q * block + col).data();
+        const double* pc = prod.col(col).data();
+        for (int l = 0; l < m; ++l) jc[rows[static_cast<std::size_t>(l)]] += pc[l];
+      }
+    }
+  }
+  stats_.jacobian_seconds += clock.seconds();
+}
+
+Eigen::MatrixXd ReducedEquations::dense_jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks) const {
+  Eigen::MatrixXd g;
+  assemble(frequency_hz, g, nullptr);
+  const int block = contacts_.pair_layout().size();
+  Eigen::MatrixXd J = Eigen::MatrixXd::Identity(size(), size());
+  for (int p = 0; p < contacts_.n_pairs(); ++p)
+    J.middleCols(p * block, block).noalias() += g.middleCols(p * block, block) * blocks[static_cast<std::size_t>(p)];
+  return J;
+}
+
+bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r,
+                                Eigen::MatrixXd* J, Eigen::VectorXd* dr_dlambda) {
+  if (!w.allFinite() || !std::isfinite(frequency_hz) || frequency_hz <= 0) return false;
+  // The continuation evaluates its converged point once more for the tangent: a repeat.
+  if (previous_.valid && previous_.frequency_hz == frequency_hz && previous_.scale == excitation_scale_ &&
+      (!J || previous_.has_jacobian) && (!dr_dlambda || previous_.has_derivative) && previous_.w.size() == w.size() &&
+      previous_.w == w) {
+    ++stats_.repeated_evaluations;
+    r = previous_.r;
+    if (J) *J = previous_.J;
+    if (dr_dlambda) *dr_dlambda = previous_.dl;
+    return true;
+  }
+  previous_.valid = false;
+  const Harmonics& hs = harmonics(frequency_hz, dr_dlambda != nullptr);
+  {
+    log::Stopwatch clock;
+    contacts_.evaluate(w, f_, J ? &blocks_ : nullptr);
+    stats_.contact_seconds += clock.seconds();
+  }
+  ++stats_.evaluations;
+  if (J) ++stats_.jacobian_evaluations;
+  Eigen::VectorXd gf;
+  apply(hs.g, f_, gf);
+  r = w + gf;
+  for (int n = 0; n <= contacts_.pair_layout().n_harmonics(); ++n)
+    add_harmonic(-excitation_scale_ * hs.w_lin[static_cast<std::size_t>(n)], n, r);
+  if (dr_dlambda) {
+    apply(hs.dg, f_, *dr_dlambda);
+    for (int n = 0; n <= contacts_.pair_layout().n_harmonics(); ++n)
+      add_harmonic(-excitation_scale_ * hs.dw_lin[static_cast<std::size_t>(n)], n, *dr_dlambda);
+    *dr_dlambda *= kTwoPi;  // d/df = 2 pi d/dw
+  }
+  if (J) jacobian(frequency_hz, blocks_, *J);
+  const bool ok = r.allFinite() && (!J || J->allFinite()) && (!dr_dlambda || dr_dlambda->allFinite());
+  if (ok && (!J || static_cast<double>(J->size()) <= kCopyLimit)) {
+    previous_.valid = true;
+    previous_.has_jacobian = J != nullptr;
+    previous_.has_derivative = dr_dlambda != nullptr;
+    previous_.frequency_hz = frequency_hz;
+    previous_.scale = excitation_scale_;
+    previous_.w = w;
+    previous_.r = r;
+    if (J) previous_.J = *J;
+    if (dr_dlambda) previous_.dl = *dr_dlambda;
+  }
+  return ok;
+}
+
+bool ReducedEquations::gmres(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d,
+                             int& iterations) const {
+  // Right-preconditioned GMRES, M^-1 = lu_ (an earlier augmented matrix), classical
+  // Gram-Schmidt applied twice, Givens rotations on the Hessenberg matrix.
+  const Eigen::Index m = A.rows();
+  const int kmax = solver_.krylov_max_iterations;
+  const double beta = b.norm();
+  iterations = 0;
+  if (beta == 0.0) {
+    d.setZero(m);
+    return true;
+  }
+  Eigen::MatrixXd V(m, kmax + 1), Z(m, kmax), H = Eigen::MatrixXd::Zero(kmax + 1, kmax);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(kmax + 1), cs(kmax), sn(kmax), w(m), hcol(kmax + 1);
+  V.col(0) = b / beta;
+  g[0] = beta;
+  int k = 0;
+  for (; k < kmax; ++k) {
+    Z.col(k) = lu_.solve(V.col(k));
+    w.noalias() = A * Z.col(k);
+    auto basis = V.leftCols(k + 1);
+    hcol.head(k + 1).noalias() = basis.transpose() * w;
+    w.noalias() -= basis * hcol.head(k + 1);
+    const Eigen::VectorXd again = basis.transpose() * w;
+    w.noalias() -= basis * again;
+    hcol.head(k + 1) += again;
+    const double hn = w.norm();
+    H.col(k).head(k + 1) = hcol.head(k + 1);
+    H(k + 1, k) = hn;
+    if (hn > 0) V.col(k + 1) = w / hn;
+    for (int i = 0; i < k; ++i) {
+      const double a = H(i, k), c = H(i + 1, k);
+      H(i, k) = cs[i] * a + sn[i] * c;
+      H(i + 1, k) = -sn[i] * a + cs[i] * c;
+    }
+    const double a = H(k, k), c = H(k + 1, k), rho = std::hypot(a, c);
+    if (!(rho > 0)) return false;
+    cs[k] = a / rho;
+    sn[k] = c / rho;
+    H(k, k) = rho;
+    H(k + 1, k) = 0.0;
+    g[k + 1] = -sn[k] * g[k];
+    g[k] = cs[k] * g[k];
+    if (std::abs(g[k + 1]) <= 0.1 * solver_.krylov_tolerance * beta || hn == 0.0) {
+      ++k;
+      break;
+    }
+  }
+  iterations = k;
+  const Eigen::VectorXd y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+  d.noalias() = Z.leftCols(k) * y;
+  // The true residual decides (round-off in the recurrence, a stagnating Krylov space).
+  return d.allFinite() && (A * d - b).norm() <= solver_.krylov_tolerance * beta;
+}
+
+bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) {
+  log::Stopwatch clock;
+  const bool krylov = solver_.kind == LinearSolverOptions::Kind::krylov ||
+                      (solver_.kind == LinearSolverOptions::Kind::automatic && A.rows() >= solver_.krylov_min_size);
+  bool ok = false;
+  if (krylov && lu_valid_ && !refactor_ && lu_.rows() == A.rows()) {
+    int iterations = 0;
+    ok = gmres(A, b, d, iterations);
+    stats_.krylov_iterations += iterations;
+    if (ok) {
+      ++stats_.krylov_solves;
+      refactor_ = iterations > solver_.refactor_after;
+    } else {
+      ++stats_.krylov_failures;
+    }
+  }
+  if (!ok) {
+    lu_.compute(A);
+    ++stats_.dense_factorizations;
+    lu_valid_ = krylov;
+    refactor_ = false;
+    d = lu_.solve(b);
+    ok = d.allFinite();
+  }
+  stats_.solve_seconds += clock.seconds();
+  return ok;
 }
 
 Eigen::VectorXd ReducedEquations::linear_motion(double frequency_hz) const {
-  Eigen::MatrixXd g;
-  Eigen::VectorXd w_lin;
-  assemble(frequency_hz, g, &w_lin);
+  const int h = contacts_.pair_layout().n_harmonics();
+  Eigen::VectorXd w_lin = Eigen::VectorXd::Zero(size());
+  frf::HarmonicReceptance rec;
+  for (int n = 0; n <= h; ++n) {
+    linear_.harmonic(n, kTwoPi * frequency_hz, rec);
+    add_harmonic(rec.w_lin, n, w_lin);
+  }
   return w_lin;
 }
 
 Eigen::VectorXd ReducedEquations::stuck_solution(double frequency_hz) const {
-  Eigen::MatrixXd g;
-  Eigen::VectorXd w_lin;
-  assemble(frequency_hz, g, &w_lin);
   // Stuck, closed contacts: F = Kc W + F_pre (F_pre: the preload in the static normal term).
-  const int size = contacts_.size(), block = contacts_.pair_layout().size(), per = contacts_.pair_layout().per_direction();
-  Eigen::VectorXd kc = Eigen::VectorXd::Zero(size), f_pre = Eigen::VectorXd::Zero(size);
+  // Kc is diagonal and the same in every harmonic, so each harmonic is one complex c x c
+  // solve: (I + G_n Kc) W_n = s W_lin,n - G_n F_pre,n.
+  const int h = contacts_.pair_layout().n_harmonics(), c = linear_.n_contact();
+  Eigen::VectorXd kc = Eigen::VectorXd::Zero(c);
+  Eigen::VectorXcd f_pre = Eigen::VectorXcd::Zero(c);
   for (int p = 0; p < contacts_.n_pairs(); ++p) {
     const auto& pp = contacts_.pairs()[static_cast<std::size_t>(p)];
     for (int d = 0; d < n_directions_; ++d) {
       const bool normal = n_directions_ == 3 && d == 2;
-      kc.segment(p * block + d * per, per).setConstant(normal ? pp.normal_stiffness : pp.tangential_stiffness);
+      kc[3 * p + d] = normal ? pp.normal_stiffness : pp.tangential_stiffness;
     }
-    if (n_directions_ == 3) f_pre[index(p, 2, 0, false)] = std::max(0.0, pp.normal_preload);
+    if (n_directions_ == 3) f_pre[3 * p + 2] = std::max(0.0, pp.normal_preload);
   }
-  Eigen::MatrixXd a = g * kc.asDiagonal();
-  a.diagonal().array() += 1.0;
-  return Eigen::PartialPivLU<Eigen::MatrixXd>(a).solve(excitation_scale_ * w_lin - g * f_pre);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(size());
+  frf::HarmonicReceptance rec;
+  for (int n = 0; n <= h; ++n) {
+    linear_.harmonic(n, kTwoPi * frequency_hz, rec);
+    Eigen::MatrixXcd a = rec.G * kc.asDiagonal();
+    a.diagonal().array() += 1.0;
+    Eigen::VectorXcd rhs = excitation_scale_ * rec.w_lin;
+    if (n == 0) rhs -= rec.G * f_pre;
+    add_harmonic(Eigen::PartialPivLU<Eigen::MatrixXcd>(a).solve(rhs), n, w);
+  }
+  return w;
 }
 
 namespace {
@@ -157,6 +391,9 @@ class ExcitationHomotopy : public continuation::ParametricResidual {
     const bool ok = eq_.evaluate(w, frequency_hz_, r, J, nullptr);
     if (dl) *dl = -lin_;
     return ok;
+  }
+  bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override {
+    return eq_.solve_augmented(A, b, d);
   }
   Eigen::VectorXd lin_;
 
@@ -196,9 +433,8 @@ PointResult ReducedEquations::analyse(const Eigen::VectorXd& w, double frequency
   const hbm::EvaluationStatus status = contacts_.evaluate(w, f_, nullptr);
   res.unconverged_pairs = status.unconverged_pairs;
   const double omega = kTwoPi * frequency_hz;
-  std::vector<frf::HarmonicReceptance> rec;
-  Eigen::MatrixXd g;
-  assemble(frequency_hz, g, nullptr, &rec);
+  std::vector<frf::HarmonicReceptance> rec(h + 1);
+  for (int n = 0; n <= h; ++n) linear_.harmonic(n, omega, rec[n]);
   std::vector<Eigen::VectorXcd> u(h + 1), forces(h + 1);
   res.harmonic_amplitudes.resize(h + 1);
   for (int n = 0; n <= h; ++n) {

@@ -6,8 +6,26 @@
 // layout (pairs one after the other, each [x | y | z] blocks of [c0 | c1 s1 | ... | cH sH]);
 // G(w) is the real form of the complex receptances G_n(n w) of each harmonic: with
 // U_n = c_n - i s_n, (A + iB) U_n maps (c, s) to (A c + B s, A s - B c).
-// dF/dW is block diagonal over pairs, so J is formed as I + G D block column by block column.
+// dF/dW is block diagonal over pairs and G couples only coefficients of the same harmonic, so
+// J = I + G D is formed per pair and per harmonic: G_n (real form, 2c x 2c) times the rows of
+// harmonic n of the pair's block D_p, O(n^2) flops instead of the O(n^2 b) of a dense product
+// (b = 3(2H+1) the pair block). The residual never forms the dense G.
+//
+// Linear solves (solve_augmented, the continuation's (n+1) augmented Newton system). G has
+// a low-rank modal part but its residual/static flexibility is full rank over the contact
+// DOFs (c = 3 pairs per harmonic), so J - I has full rank and no exact low-rank shortcut
+// exists: the structure exploited is that the Jacobian changes little from one Newton
+// iteration and continuation step to the next. Above `krylov_min_size` unknowns the system
+// is solved by GMRES (exact products with the dense augmented matrix) right-preconditioned
+// by the LU factors of an earlier augmented matrix; the factors are renewed when GMRES needs
+// many iterations or fails, so the worst case is the dense LU. The solution is checked by
+// its true residual ||A d - b|| <= krylov_tolerance ||b||.
+//
+// The residual also gives dr/df (f the frequency in Hz) from the linear part's exact
+// frequency derivative (no extra contact evaluations), and repeats of an evaluation at the
+// same (W, f) (the continuation evaluates the converged point twice) are served from a copy.
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <vector>
 
 #include "continuation/arclength.hpp"
@@ -29,6 +47,31 @@ struct PointResult {
   int unconverged_pairs = 0;
 };
 
+/// How solve_augmented() solves the augmented Newton systems.
+struct LinearSolverOptions {
+  enum class Kind { dense, krylov, automatic };
+  Kind kind = Kind::automatic;     ///< automatic: krylov from krylov_min_size unknowns on
+  int krylov_min_size = 250;       ///< (n + 1) below which automatic uses the dense LU
+  int krylov_max_iterations = 40;  ///< GMRES iterations before falling back to a new LU
+  int refactor_after = 15;         ///< GMRES iterations above which the next solve refactors
+  double krylov_tolerance = 1e-11; ///< relative true residual ||A d - b|| / ||b||
+};
+
+/// Where the time goes (seconds of wall time, counts), accumulated over the object's life.
+struct SolverStatistics {
+  int evaluations = 0;             ///< residual evaluations that reached the contacts
+  int jacobian_evaluations = 0;    ///< of those, with the Jacobian
+  int repeated_evaluations = 0;    ///< served from the copy of the previous evaluation
+  int dense_factorizations = 0;    ///< LU factorizations of an augmented matrix
+  int krylov_solves = 0;           ///< solves done by preconditioned GMRES
+  int krylov_iterations = 0;       ///< their GMRES iterations
+  int krylov_failures = 0;         ///< GMRES solves that fell back to a new LU
+  double contact_seconds = 0.0;    ///< ContactEvaluator::evaluate
+  double receptance_seconds = 0.0; ///< G_n, W_lin,n and their frequency derivatives
+  double jacobian_seconds = 0.0;   ///< forming I + G D
+  double solve_seconds = 0.0;      ///< solve_augmented
+};
+
 class ReducedEquations : public continuation::ParametricResidual {
  public:
   /// Not owned: linear and contacts outlive this object. contacts' pairs are the linear
@@ -38,6 +81,18 @@ class ReducedEquations : public continuation::ParametricResidual {
   int size() const override { return contacts_.size(); }
   bool evaluate(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r, Eigen::MatrixXd* J,
                 Eigen::VectorXd* dr_dlambda) override;
+  /// dr/df [m/Hz] = 2 pi (dG/dw F - s dW_lin/dw), exact from the linear part.
+  bool has_lambda_derivative() const override { return true; }
+  bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override;
+
+  void set_linear_solver(const LinearSolverOptions& options) { solver_ = options; lu_valid_ = false; }
+  const LinearSolverOptions& linear_solver() const { return solver_; }
+  const SolverStatistics& statistics() const { return stats_; }
+  /// The Jacobian I + G(f) D formed densely the plain way (G as a dense n x n real matrix times
+  /// the block-diagonal D): the reference the structured product is tested against.
+  Eigen::MatrixXd dense_jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks) const;
+  /// Forms J = I + G(f) D from given per-pair blocks D_p (the structured product).
+  void jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks, Eigen::MatrixXd& J);
 
   /// W_lin(w) in the evaluator layout (the contact motion without contact forces).
   Eigen::VectorXd linear_motion(double frequency_hz) const;
@@ -61,6 +116,15 @@ class ReducedEquations : public continuation::ParametricResidual {
   const hbm::HarmonicLayout& pair_layout() const { return contacts_.pair_layout(); }
 
  private:
+  /// The complex G_n (c x c) and W_lin,n (c) of every harmonic at one frequency (and, when
+  /// asked, their derivatives d/dw), kept until the frequency changes.
+  struct Harmonics {
+    double frequency_hz = -1.0;
+    bool derivative = false;
+    std::vector<Eigen::MatrixXcd> g, dg;
+    std::vector<Eigen::VectorXcd> w_lin, dw_lin;
+  };
+  const Harmonics& harmonics(double frequency_hz, bool derivative);
   /// Real form of G(w) (size x size) and W_lin(w) (size).
   void assemble(double frequency_hz, Eigen::MatrixXd& g, Eigen::VectorXd* w_lin,
                 std::vector<frf::HarmonicReceptance>* receptances = nullptr) const;
@@ -68,6 +132,11 @@ class ReducedEquations : public continuation::ParametricResidual {
   int index(int pair, int direction, int harmonic, bool sine) const;
   /// Complex harmonic n of a vector in the evaluator layout, as a c-vector (3 per pair).
   Eigen::VectorXcd complex_harmonic(const Eigen::VectorXd& v, int n) const;
+  /// out += the evaluator-layout vector whose harmonic n is z (c-vector).
+  void add_harmonic(const Eigen::VectorXcd& z, int n, Eigen::VectorXd& out) const;
+  /// out = sum_n M_n v_n (M = g or dg of h): a block-diagonal-over-harmonics product.
+  void apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
+  bool gmres(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d, int& iterations) const;
 
   const frf::LinearPart& linear_;
   hbm::ContactEvaluator& contacts_;
@@ -75,6 +144,19 @@ class ReducedEquations : public continuation::ParametricResidual {
   double excitation_scale_ = 1.0;
   Eigen::VectorXd f_;                       // scratch: contact forces
   std::vector<Eigen::MatrixXd> blocks_;     // scratch: dF_p/dW_p
+  Harmonics harmonics_;
+  LinearSolverOptions solver_;
+  SolverStatistics stats_;
+  // The previous evaluation, for repeats at the same point.
+  struct Previous {
+    bool valid = false, has_jacobian = false, has_derivative = false;
+    double frequency_hz = 0.0, scale = 0.0;
+    Eigen::VectorXd w, r, dl;
+    Eigen::MatrixXd J;
+  } previous_;
+  // Lagged preconditioner: LU factors of an earlier augmented matrix.
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  bool lu_valid_ = false, refactor_ = false;
 };
 
 }  // namespace shroudsim::forced

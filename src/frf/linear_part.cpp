@@ -1,1 +1,17 @@
 #include "frf/linear_part.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace shroudsim::frf {
+
+void LinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const {
+  const double h = 1e-6 * std::max(std::abs(w), 1.0);
+  HarmonicReceptance plus, minus;
+  harmonic(n, w + h, plus);
+  harmonic(n, w - h, minus);
+  dG = (plus.G - minus.G) / (2.0 * h);
+  dw_lin = (plus.w_lin - minus.w_lin) / (2.0 * h);
+}
+
+}  // namespace shroudsim::frf

@@ -108,6 +108,28 @@ void SectorLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const 
   }
 }
 
+void SectorLinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const {
+  const int c = n_contact();
+  if (n == 0) {
+    dG = Eigen::MatrixXcd::Zero(c, c);
+    dw_lin = Eigen::VectorXcd::Zero(c);
+    return;
+  }
+  const IndexData& d = dynamic_.at(harmonic_index(n));
+  const double big_w = n * w, z = forcing_.damping_ratio;
+  Eigen::VectorXcd dinv(d.omega.size());
+  for (Eigen::Index r = 0; r < d.omega.size(); ++r) {
+    const Complex den(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+    dinv[r] = static_cast<double>(n) * Complex(2.0 * big_w, -2.0 * z * d.omega[r]) / (den * den);
+  }
+  const auto psi_c = d.psi.topRows(c);
+  dG = psi_c * dinv.asDiagonal() * psi_c.adjoint();
+  if (n == 1)
+    dw_lin = psi_c * dinv.asDiagonal() * d.psi.row(c + 3).adjoint();
+  else
+    dw_lin = Eigen::VectorXcd::Zero(c);
+}
+
 void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
                               double& viscous_dissipation) const {
   constexpr double kPi = std::numbers::pi;

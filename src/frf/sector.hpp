@@ -51,6 +51,9 @@ class SectorLinearPart : public LinearPart {
   int n_contact() const override { return 3 * static_cast<int>(pairs_.size()); }
   int n_response() const override { return 3; }
   void harmonic(int n, double w, HarmonicReceptance& out) const override;
+  /// Exact: d/dw 1/(w_r^2 - W^2 + 2 i z w_r W) = n (2 W - 2 i z w_r) / (...)^2, W = n w; the
+  /// residual and static flexibilities do not depend on the frequency.
+  void harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const override;
   void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
               double& viscous_dissipation) const override;
   std::string describe() const override;

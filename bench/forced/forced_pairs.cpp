@@ -1,0 +1,170 @@
+// Forced response of a case with the cost split by where it goes, and (--jacobian-check)
+// the Jacobian error against central differences along the solution curve (the paper's
+// Figure 17). A plain program (one timed pass is the figure wanted).
+//
+//   forced_pairs CASE.toml [--set KEY=VALUE]... [--threads N] [--solver dense|krylov|auto]
+//                [--jacobian-check]
+//
+// It builds the model as `shroudsim frf` does (make_sector_model / make_lumped_model, the same
+// variable scaling and continuation options), starts from the stuck-contact state (or the
+// excitation homotopy) and traces the branch over the case's range, then prints one line of
+// `key=value` pairs: points, seconds (trace only), contact/receptance/jacobian/solve seconds,
+// Newton iterations, factorizations, GMRES solves and iterations.
+//
+// --jacobian-check: at every converged point both contact Jacobians are evaluated
+// (ContactEvaluator::evaluate with JacobianMethod::analytic and ::finite_difference) and
+//   e_contact = ||D_a - D_fd||_F / ||D_a||_F       (all pairs' blocks stacked)
+//   e_full    = ||G (D_a - D_fd)||_F / ||I + G D_a||_F   (the reduced Jacobian)
+// are recorded; their maximum and median over the curve and the frequency of the maximum are
+// printed (timings then include the checks).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "app/context.hpp"
+#include "app/forced_stage.hpp"
+#include "continuation/arclength.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "forced/reduced_equations.hpp"
+#include "io/case.hpp"
+
+using namespace shroudsim;
+
+int main(int argc, char** argv) {
+  std::vector<std::string> sets;
+  std::string case_file, solver = "auto";
+  int threads = 0;
+  bool check = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--set" && i + 1 < argc) sets.push_back(argv[++i]);
+    else if (a == "--threads" && i + 1 < argc) threads = std::atoi(argv[++i]);
+    else if (a == "--solver" && i + 1 < argc) solver = argv[++i];
+    else if (a == "--jacobian-check") check = true;
+    else if (case_file.empty() && a.rfind("--", 0) != 0) case_file = a;
+    else {
+      std::cerr << "usage: forced_pairs CASE.toml [--set KEY=VALUE]... [--threads N] [--solver dense|krylov|auto] [--jacobian-check]\n";
+      return 2;
+    }
+  }
+  if (case_file.empty()) {
+    std::cerr << "usage: forced_pairs CASE.toml [--set KEY=VALUE]...\n";
+    return 2;
+  }
+  try {
+    log::set_verbose(false);
+    app::Context ctx;
+    ctx.config = io::load_case(case_file, sets);
+    ctx.threads = threads;
+    ctx.plots = false;
+    ctx.out_dir = "/tmp";
+    const io::Case& c = ctx.config;
+    app::ForcedModel model = c.structure.type == "lumped" ? app::make_lumped_model(c) : app::make_sector_model(ctx);
+    const hbm::ContactEvaluatorOptions eo = app::evaluator_options(c, threads);
+    hbm::ContactEvaluator evaluator(eo, model.pairs);
+    forced::ReducedEquations equations(*model.linear, evaluator);
+    forced::LinearSolverOptions so;
+    so.kind = solver == "dense" ? forced::LinearSolverOptions::Kind::dense
+              : solver == "krylov" ? forced::LinearSolverOptions::Kind::krylov
+                                   : forced::LinearSolverOptions::Kind::automatic;
+    equations.set_linear_solver(so);
+
+    // The variable scaling and options of cmd_frf.cpp.
+    const auto& cn = c.continuation;
+    double motion = 0.0;
+    for (int i = 0; i <= 40; ++i) {
+      const double f = cn.frequency_start_hz + (cn.frequency_end_hz - cn.frequency_start_hz) * i / 40.0;
+      motion = std::max(motion, equations.linear_motion(f).lpNorm<Eigen::Infinity>());
+    }
+    double contact_scale = 0.0;
+    for (const auto& p : model.pairs)
+      contact_scale = std::max({contact_scale, p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness,
+                                std::abs(p.normal_preload) / p.normal_stiffness});
+    const double x_scale = motion > 0 ? motion / 20.0 : std::max(contact_scale, 1e-12);
+    continuation::ArclengthOptions ao;
+    ao.lambda_start = cn.frequency_start_hz;
+    ao.lambda_end = cn.frequency_end_hz;
+    ao.x_scale = Eigen::VectorXd::Constant(equations.size(), x_scale);
+    ao.initial_step = cn.initial_step;
+    ao.max_step = std::max(1.0, std::abs(cn.frequency_end_hz - cn.frequency_start_hz) / (200.0 * cn.initial_step));
+    ao.max_points = cn.max_points;
+    ao.tolerance = c.hbm.tolerance;
+
+    log::Stopwatch clock;
+    Eigen::VectorXd start = equations.stuck_solution(ao.lambda_start);
+    std::string how = "stuck";
+    if (continuation::newton_fixed(equations, start, ao.lambda_start, ao) < 0) {
+      how = "homotopy";
+      start = equations.stuck_solution(ao.lambda_start);
+      if (equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start).status != continuation::BranchStatus::kReachedEnd)
+        throw NumericalError("no start point");
+    }
+    const double start_seconds = clock.seconds();
+
+    std::vector<double> e_contact, e_full, at;
+    double check_seconds = 0.0;
+    std::vector<Eigen::MatrixXd> da, dfd;
+    Eigen::VectorXd fa, ffd;
+    auto on_point = [&](const continuation::BranchPoint& p) {
+      if (!check) return;
+      log::Stopwatch cc;
+      evaluator.evaluate(p.x, fa, &da, hbm::JacobianMethod::analytic);
+      evaluator.evaluate(p.x, ffd, &dfd, hbm::JacobianMethod::finite_difference);
+      double num = 0.0, den = 0.0;
+      std::vector<Eigen::MatrixXd> diff(da.size());
+      for (std::size_t k = 0; k < da.size(); ++k) {
+        diff[k] = da[k] - dfd[k];
+        num += diff[k].squaredNorm();
+        den += da[k].squaredNorm();
+      }
+      e_contact.push_back(den > 0 ? std::sqrt(num / den) : std::sqrt(num));
+      // G (D_a - D_fd) = (I + G (D_a - D_fd)) - I with the structured product.
+      Eigen::MatrixXd ja, jd;
+      equations.jacobian(p.lambda, da, ja);
+      equations.jacobian(p.lambda, diff, jd);
+      jd.diagonal().array() -= 1.0;
+      e_full.push_back(jd.norm() / ja.norm());
+      at.push_back(p.lambda);
+      check_seconds += cc.seconds();
+    };
+    const continuation::Branch b = continuation::trace(equations, start, ao, on_point);
+    const double seconds = clock.seconds();
+    const forced::SolverStatistics& s = equations.statistics();
+    std::cout << std::setprecision(4) << "pairs=" << evaluator.n_pairs() << " unknowns=" << equations.size()
+              << " jacobian=" << c.hbm.jacobian << " N=" << c.hbm.time_samples << " preload=" << c.contact.normal_preload
+              << " solver=" << solver << " status=" << continuation::to_string(b.status) << " points=" << b.points.size()
+              << " start=" << how << " seconds=" << seconds - check_seconds << " start_seconds=" << start_seconds
+              << " newton=" << b.newton_iterations << " evaluations=" << s.evaluations
+              << " jacobian_evaluations=" << s.jacobian_evaluations << " repeated=" << s.repeated_evaluations
+              << " contact_s=" << s.contact_seconds << " receptance_s=" << s.receptance_seconds
+              << " jacobian_s=" << s.jacobian_seconds << " solve_s=" << s.solve_seconds
+              << " factorizations=" << s.dense_factorizations << " krylov_solves=" << s.krylov_solves
+              << " krylov_iterations=" << s.krylov_iterations << " krylov_failures=" << s.krylov_failures;
+    if (check && !e_contact.empty()) {
+      auto stats = [&](std::vector<double> v, const char* name) {
+        const auto imax = std::max_element(v.begin(), v.end()) - v.begin();
+        const double mx = v[static_cast<std::size_t>(imax)];
+        const double f_at = at[static_cast<std::size_t>(imax)];
+        std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+        std::cout << " " << name << "_max=" << mx << " " << name << "_median=" << v[v.size() / 2] << " " << name
+                  << "_max_at_hz=" << f_at;
+      };
+      stats(e_contact, "e_contact");
+      stats(e_full, "e_full");
+      std::cout << " check_seconds=" << check_seconds;
+    }
+    std::cout << "\n";
+    return b.status == continuation::BranchStatus::kReachedEnd ? 0 : 3;
+  } catch (const InputError& e) {
+    std::cerr << "forced_pairs: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "forced_pairs: " << e.what() << "\n";
+    return 1;
+  }
+}
