@@ -227,7 +227,9 @@ int run_convergence(Context& ctx) {
     cases.push_back(io::load_case(c.file, sets));
   }
   log::info("study --convergence: " + std::to_string(knobs.size()) + " knobs, " + std::to_string(points.size()) + " runs");
+  log::Stopwatch clock;
   const int workers = run_points(ctx, cases, points);
+  ctx.report.stage("study", clock.seconds());
 
   std::ostringstream csv;
   csv << "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,peaks_error,"

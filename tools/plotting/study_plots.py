@@ -64,7 +64,7 @@ def plot_trade(result_dir):
     for r in rows:
         if r["knob"] not in knobs:
             knobs.append(r["knob"])
-    fig, ax = plt.subplots(figsize=(9, 6))
+    fig, ax = plt.subplots(figsize=(12, 6))
     floor = min([float(r["peaks_error"]) for r in rows if float(r["peaks_error"]) > 0] or [1e-12]) / 3
     pts = []
     markers = "osD^v<>ph*"
@@ -93,7 +93,7 @@ def plot_trade(result_dir):
     ax.set_xlabel("CPU time of the run [s]")
     ax.set_ylabel("largest relative change of a resonance peak vs the knob's reference")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.set_title(os.path.basename(os.path.normpath(result_dir)) + ": accuracy against cost, one knob at a time")
     fig.tight_layout()
     fig.savefig(os.path.join(result_dir, "trade.png"), dpi=110)
