@@ -1,7 +1,9 @@
 // Pseudo-arclength continuation against curves known in closed form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "continuation/arclength.hpp"
 
@@ -153,6 +155,60 @@ TEST(Arclength, FiniteDifferenceInLambdaGivesTheSameCurve) {
   ASSERT_EQ(b.status, BranchStatus::kReachedEnd);
   EXPECT_EQ(a.turning_points, b.turning_points);
   for (const auto& p : b.points) EXPECT_LT(exact.closed_form_error(p), 1e-6);
+}
+
+TEST(Arclength, NoAcceptedStepTurnsTheTangentMoreThanTheLimit) {
+  // Coarse steps (unscaled: the peak is ~0.5 high and ~0.02 wide) on the Duffing curve: a
+  // corrector that lands far round a bend (or on another stretch of the curve) turns the
+  // tangent by more than max_turn_deg; such steps are rejected and halved.
+  Duffing duffing(0.01, 1.0, 0.01);
+  ArclengthOptions o;
+  o.lambda_start = 0.5;
+  o.lambda_end = 1.5;
+  o.initial_step = 0.5;
+  auto max_turn = [](const Branch& b) {
+    double worst = 0.0;
+    for (std::size_t i = 1; i < b.points.size(); ++i)
+      worst = std::max(worst, std::acos(std::clamp(b.points[i].tangent.dot(b.points[i - 1].tangent), -1.0, 1.0)));
+    return worst * 180.0 / std::numbers::pi;
+  };
+  const Branch b = trace(duffing, Eigen::VectorXd::Zero(2), o);
+  ASSERT_EQ(b.status, BranchStatus::kReachedEnd) << b.message;
+  EXPECT_GT(b.rejected_turns, 0);
+  EXPECT_LE(max_turn(b), o.max_turn_deg);
+  // With the check off, the same steps do turn it further: the test exercises the check.
+  o.max_turn_deg = 179.9;
+  EXPECT_GT(max_turn(trace(duffing, Eigen::VectorXd::Zero(2), o)), 30.0);
+}
+
+/// x = 3 |lambda - 1|: a corner of 143 degrees, which no hyperplane normal to the incoming
+/// tangent meets near the corner.
+class Vee : public ParametricResidual {
+ public:
+  int size() const override { return 1; }
+  bool has_lambda_derivative() const override { return true; }
+  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd* dl) override {
+    r = Eigen::VectorXd::Constant(1, x[0] - 3.0 * std::abs(l - 1.0));
+    if (J) *J = Eigen::MatrixXd::Identity(1, 1);
+    if (dl) *dl = Eigen::VectorXd::Constant(1, l > 1.0 ? -3.0 : 3.0);
+    return true;
+  }
+};
+
+TEST(Arclength, ASharpCornerOfANonsmoothBranchIsCrossed) {
+  Vee vee;
+  ArclengthOptions o;
+  o.lambda_start = 0.0;
+  o.lambda_end = 2.0;
+  o.initial_step = 0.1;
+  o.tolerance = 1e-12;
+  const Branch b = trace(vee, Eigen::VectorXd::Constant(1, 3.0), o);
+  ASSERT_EQ(b.status, BranchStatus::kReachedEnd) << b.message;
+  EXPECT_GE(b.kinks_crossed, 1);
+  EXPECT_DOUBLE_EQ(b.points.back().lambda, 2.0);
+  for (const auto& p : b.points) EXPECT_NEAR(p.x[0], 3.0 * std::abs(p.lambda - 1.0), 1e-10) << p.lambda;
+  // Frequency-like parameter: it only moves forward (the corner is not a fold).
+  for (std::size_t i = 1; i < b.points.size(); ++i) EXPECT_GT(b.points[i].lambda, b.points[i - 1].lambda);
 }
 
 }  // namespace
