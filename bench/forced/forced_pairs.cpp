@@ -99,10 +99,55 @@ int main(int argc, char** argv) {
     Eigen::VectorXd start = equations.stuck_solution(ao.lambda_start);
     std::string how = "stuck";
     if (continuation::newton_fixed(equations, start, ao.lambda_start, ao) < 0) {
-      how = "homotopy";
-      start = equations.stuck_solution(ao.lambda_start);
-      if (equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start).status != continuation::BranchStatus::kReachedEnd)
-        throw NumericalError("no start point");
+      how = "free";
+      start = equations.linear_motion(ao.lambda_start);
+    }
+    if (how == "free" && continuation::newton_fixed(equations, start, ao.lambda_start, ao) < 0) {
+      // Harmonic stepping as in cmd_frf.cpp: H = 1, then one harmonic at a time from zero.
+      how = "harmonic_stepping";
+      Eigen::VectorXd prev;
+      int prev_h = 0;
+      for (int h = 1; h <= eo.n_harmonics; ++h) {
+        hbm::ContactEvaluatorOptions step_options = eo;
+        step_options.n_harmonics = h;
+        hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
+        forced::ReducedEquations step_equations(*model.linear, step_evaluator);
+        continuation::ArclengthOptions o = ao;
+        o.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
+        Eigen::VectorXd w;
+        if (h == 1) {
+          w = step_equations.stuck_solution(ao.lambda_start);
+          if (continuation::newton_fixed(step_equations, w, ao.lambda_start, o) < 0) {
+            w = step_equations.stuck_solution(ao.lambda_start);
+            if (step_equations.solve_by_excitation_homotopy(ao.lambda_start, o, w).status !=
+                continuation::BranchStatus::kReachedEnd)
+              break;
+          }
+        } else {
+          w = Eigen::VectorXd::Zero(step_equations.size());
+          const auto& lo = step_evaluator.pair_layout();
+          const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
+          for (int p = 0; p < step_evaluator.n_pairs(); ++p)
+            for (int d = 0; d < lo.n_directions(); ++d)
+              for (int n = 0; n <= prev_h; ++n)
+                for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
+                  if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
+                  w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
+                }
+          if (continuation::newton_fixed(step_equations, w, ao.lambda_start, o) < 0) break;
+        }
+        prev = w;
+        prev_h = h;
+      }
+      if (prev_h == eo.n_harmonics) {
+        start = prev;
+      } else {
+        how = "homotopy";
+        start = equations.stuck_solution(ao.lambda_start);
+        if (equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start).status !=
+            continuation::BranchStatus::kReachedEnd)
+          throw NumericalError("no start point");
+      }
     }
     const double start_seconds = clock.seconds();
 
@@ -144,12 +189,39 @@ int main(int argc, char** argv) {
               << " contact_s=" << s.contact_seconds << " receptance_s=" << s.receptance_seconds
               << " jacobian_s=" << s.jacobian_seconds << " solve_s=" << s.solve_seconds
               << " factorizations=" << s.dense_factorizations << " krylov_solves=" << s.krylov_solves
-              << " krylov_iterations=" << s.krylov_iterations << " krylov_failures=" << s.krylov_failures;
+              << " krylov_iterations=" << s.krylov_iterations << " krylov_failures=" << s.krylov_failures << " krylov_structured=" << s.krylov_structured;
+    // Cost of one contact evaluation of all pairs at the last point (median of 7): residual
+    // only, with the analytic Jacobian, with the block finite-difference Jacobian (2 residuals
+    // per coefficient of each pair: what hbm.jacobian = "finite_difference" does), and what a
+    // finite difference of the whole residual vector would cost (2 n residual evaluations of
+    // all pairs: no use of the block-diagonal structure).
+    if (!b.points.empty()) {
+      const Eigen::VectorXd& x = b.points.back().x;
+      auto median_ms = [&](auto&& fn) {
+        std::vector<double> t;
+        for (int k = 0; k < 7; ++k) {
+          log::Stopwatch sw;
+          fn();
+          t.push_back(1e3 * sw.seconds());
+        }
+        std::nth_element(t.begin(), t.begin() + 3, t.end());
+        return t[3];
+      };
+      Eigen::VectorXd fx;
+      std::vector<Eigen::MatrixXd> jx;
+      const double res_ms = median_ms([&] { evaluator.evaluate(x, fx, nullptr); });
+      const double an_ms = median_ms([&] { evaluator.evaluate(x, fx, &jx, hbm::JacobianMethod::analytic); });
+      const double fd_ms = median_ms([&] { evaluator.evaluate(x, fx, &jx, hbm::JacobianMethod::finite_difference); });
+      std::cout << " residual_ms=" << res_ms << " analytic_ms=" << an_ms << " fd_block_ms=" << fd_ms
+                << " fd_whole_ms=" << 2.0 * equations.size() * res_ms;
+    }
     if (check && !e_contact.empty()) {
       auto stats = [&](std::vector<double> v, const char* name) {
         const auto imax = std::max_element(v.begin(), v.end()) - v.begin();
         const double mx = v[static_cast<std::size_t>(imax)];
         const double f_at = at[static_cast<std::size_t>(imax)];
+        const auto above = std::count_if(v.begin(), v.end(), [](double e) { return e > 1e-6; });
+        std::cout << " " << name << "_points_above_1e-6=" << above;
         std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
         std::cout << " " << name << "_max=" << mx << " " << name << "_median=" << v[v.size() / 2] << " " << name
                   << "_max_at_hz=" << f_at;

@@ -239,7 +239,12 @@ bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, E
       add_harmonic(-excitation_scale_ * hs.dw_lin[static_cast<std::size_t>(n)], n, *dr_dlambda);
     *dr_dlambda *= kTwoPi;  // d/df = 2 pi d/dw
   }
-  if (J) jacobian(frequency_hz, blocks_, *J);
+  if (J) {
+    jacobian(frequency_hz, blocks_, *J);
+    jac_g_ = hs.g;
+    jac_blocks_ = blocks_;
+    jac_valid_ = true;
+  }
   const bool ok = r.allFinite() && (!J || J->allFinite()) && (!dr_dlambda || dr_dlambda->allFinite());
   if (ok && (!J || static_cast<double>(J->size()) <= kCopyLimit)) {
     previous_.valid = true;
@@ -255,7 +260,17 @@ bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, E
   return ok;
 }
 
-bool ReducedEquations::gmres(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d,
+void ReducedEquations::apply_jacobian(const Eigen::VectorXd& z, Eigen::VectorXd& y) const {
+  const int block = contacts_.pair_layout().size();
+  Eigen::VectorXd dz(size());
+  for (int p = 0; p < contacts_.n_pairs(); ++p)
+    dz.segment(p * block, block).noalias() = jac_blocks_[static_cast<std::size_t>(p)] * z.segment(p * block, block);
+  apply(jac_g_, dz, y);
+  y += z.head(size());
+}
+
+bool ReducedEquations::gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op,
+                             const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d,
                              int& iterations) const {
   // Right-preconditioned GMRES, M^-1 = lu_ (an earlier augmented matrix), classical
   // Gram-Schmidt applied twice, Givens rotations on the Hessenberg matrix.
@@ -274,7 +289,7 @@ bool ReducedEquations::gmres(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
   int k = 0;
   for (; k < kmax; ++k) {
     Z.col(k) = lu_.solve(V.col(k));
-    w.noalias() = A * Z.col(k);
+    op(Z.col(k), w);
     auto basis = V.leftCols(k + 1);
     hcol.head(k + 1).noalias() = basis.transpose() * w;
     w.noalias() -= basis * hcol.head(k + 1);
@@ -316,8 +331,31 @@ bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::Ve
                       (solver_.kind == LinearSolverOptions::Kind::automatic && A.rows() >= solver_.krylov_min_size);
   bool ok = false;
   if (krylov && lu_valid_ && !refactor_ && lu_.rows() == A.rows()) {
+    const int n = size();
+    auto dense_op = [&](const Eigen::VectorXd& z, Eigen::VectorXd& y) { y.noalias() = A * z; };
+    auto structured_op = [&](const Eigen::VectorXd& z, Eigen::VectorXd& y) {
+      Eigen::VectorXd jz;
+      apply_jacobian(z, jz);
+      y.resize(n + 1);
+      y.head(n) = jz + A.col(n).head(n) * z[n];
+      y[n] = A.row(n).dot(z);
+    };
+    // Is A's Jacobian block the last J? (One dense product with a fixed pseudo-random probe.)
+    bool structured = false;
+    if (structured_ok_ && jac_valid_ && A.rows() == n + 1) {
+      const Eigen::VectorXd probe = Eigen::VectorXd::LinSpaced(n + 1, 1.0, 2.0).array().sin();
+      Eigen::VectorXd ya, ys;
+      dense_op(probe, ya);
+      structured_op(probe, ys);
+      structured = (ya - ys).norm() <= 1e-12 * ya.norm();
+      if (!structured && ++probe_failures_ >= 3) structured_ok_ = false;  // another scaling: stop probing
+    }
+    if (structured) ++stats_.krylov_structured;
     int iterations = 0;
-    ok = gmres(A, b, d, iterations);
+    if (structured)
+      ok = gmres(structured_op, A, b, d, iterations);
+    else
+      ok = gmres(dense_op, A, b, d, iterations);
     stats_.krylov_iterations += iterations;
     if (ok) {
       ++stats_.krylov_solves;

@@ -18,14 +18,19 @@
 // iteration and continuation step to the next. Above `krylov_min_size` unknowns the system
 // is solved by GMRES (exact products with the dense augmented matrix) right-preconditioned
 // by the LU factors of an earlier augmented matrix; the factors are renewed when GMRES needs
-// many iterations or fails, so the worst case is the dense LU. The solution is checked by
-// its true residual ||A d - b|| <= krylov_tolerance ||b||.
+// many iterations or fails, so the worst case is the dense LU. The GMRES products use the
+// factors, (I + G D) z = z + G (D z) per pair and per harmonic (O(n b + c^2 H) instead of the
+// O(n^2) of the dense A), once a random probe has shown that A's Jacobian block is that J (the
+// continuation's scaling cancels when x and r share one constant scale; otherwise the dense A
+// is used). The solution is checked by its true residual with the dense A,
+// ||A d - b|| <= krylov_tolerance ||b||.
 //
 // The residual also gives dr/df (f the frequency in Hz) from the linear part's exact
 // frequency derivative (no extra contact evaluations), and repeats of an evaluation at the
 // same (W, f) (the continuation evaluates the converged point twice) are served from a copy.
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <functional>
 #include <vector>
 
 #include "continuation/arclength.hpp"
@@ -66,6 +71,7 @@ struct SolverStatistics {
   int krylov_solves = 0;           ///< solves done by preconditioned GMRES
   int krylov_iterations = 0;       ///< their GMRES iterations
   int krylov_failures = 0;         ///< GMRES solves that fell back to a new LU
+  int krylov_structured = 0;       ///< GMRES solves with the structured product (I + G D) z
   double contact_seconds = 0.0;    ///< ContactEvaluator::evaluate
   double receptance_seconds = 0.0; ///< G_n, W_lin,n and their frequency derivatives
   double jacobian_seconds = 0.0;   ///< forming I + G D
@@ -136,7 +142,11 @@ class ReducedEquations : public continuation::ParametricResidual {
   void add_harmonic(const Eigen::VectorXcd& z, int n, Eigen::VectorXd& out) const;
   /// out = sum_n M_n v_n (M = g or dg of h): a block-diagonal-over-harmonics product.
   void apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
-  bool gmres(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d, int& iterations) const;
+  /// GMRES on A d = b with the product `op` (the action of A) and M^-1 = lu_.
+  bool gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op, const Eigen::MatrixXd& A,
+             const Eigen::VectorXd& b, Eigen::VectorXd& d, int& iterations) const;
+  /// y = (I + G D) z with the G_n and D_p of the last Jacobian evaluation: O(n b + c^2 H).
+  void apply_jacobian(const Eigen::VectorXd& z, Eigen::VectorXd& y) const;
 
   const frf::LinearPart& linear_;
   hbm::ContactEvaluator& contacts_;
@@ -154,6 +164,11 @@ class ReducedEquations : public continuation::ParametricResidual {
     Eigen::VectorXd w, r, dl;
     Eigen::MatrixXd J;
   } previous_;
+  // The factors of the last Jacobian evaluation, for products with J without the dense J.
+  std::vector<Eigen::MatrixXcd> jac_g_;
+  std::vector<Eigen::MatrixXd> jac_blocks_;
+  bool jac_valid_ = false, structured_ok_ = true;
+  int probe_failures_ = 0;
   // Lagged preconditioner: LU factors of an earlier augmented matrix.
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   bool lu_valid_ = false, refactor_ = false;

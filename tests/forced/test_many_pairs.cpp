@@ -334,6 +334,16 @@ TEST(ManyPairsSector, AllShroudPairsKrylovAndDenseSolvesAgree) {
   const Eigen::VectorXd ref = Eigen::PartialPivLU<Eigen::MatrixXd>(a1).solve(b);
   EXPECT_LE((d - ref).norm(), 1e-9 * ref.norm());
   EXPECT_EQ(eq.statistics().krylov_solves, 1);
+  // a1's Jacobian block is the last evaluated J: GMRES used the structured product.
+  EXPECT_EQ(eq.statistics().krylov_structured, 1);
+  // A scaled Jacobian block (not the last J): the probe sees it, the dense A is used, and
+  // the solve is still right.
+  Eigen::MatrixXd a2 = a1;
+  a2.topLeftCorner(n, n) *= 1.0001;
+  ASSERT_TRUE(eq.solve_augmented(a2, b, d));
+  const Eigen::VectorXd ref2 = Eigen::PartialPivLU<Eigen::MatrixXd>(a2).solve(b);
+  EXPECT_LE((d - ref2).norm(), 1e-9 * ref2.norm());
+  EXPECT_EQ(eq.statistics().krylov_structured, 1);
 }
 
 }  // namespace
