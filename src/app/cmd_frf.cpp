@@ -464,6 +464,19 @@ int cmd_frf(Context& ctx) {
   j["peak_amplitude_m"] = peak;
   j["peak_frequency_hz"] = peak_f;
   j["unconverged_periodic_pairs"] = unconverged;
+  // Where the forced response's time went (all pieces; start searches with other H excluded).
+  const forced::SolverStatistics& st = equations.statistics();
+  j["solver"] = {{"evaluations", st.evaluations},
+                 {"jacobian_evaluations", st.jacobian_evaluations},
+                 {"repeated_evaluations", st.repeated_evaluations},
+                 {"dense_factorizations", st.dense_factorizations},
+                 {"krylov_solves", st.krylov_solves},
+                 {"krylov_iterations", st.krylov_iterations},
+                 {"krylov_failures", st.krylov_failures},
+                 {"contact_seconds", st.contact_seconds},
+                 {"receptance_seconds", st.receptance_seconds},
+                 {"jacobian_seconds", st.jacobian_seconds},
+                 {"solve_seconds", st.solve_seconds}};
   ctx.report.stage("frf", clock.seconds());
   if (unconverged > 0)
     ctx.report.warn(std::to_string(unconverged) + " contact evaluations did not reach a periodic state within the period cap");

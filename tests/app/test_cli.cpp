@@ -186,6 +186,7 @@ TEST(Cli, FrfWritesTheContractColumnsAndNoNaN) {
   }
   const std::string run = slurp(s.dir() / "results" / "jenkins" / "run.json");
   EXPECT_NE(run.find("\"max_energy_balance_error\""), std::string::npos);
+  EXPECT_NE(run.find("\"jacobian_evaluations\""), std::string::npos) << "solver statistics in run.json";
   EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "loops.csv"));
 }
 
