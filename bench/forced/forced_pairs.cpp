@@ -74,81 +74,13 @@ int main(int argc, char** argv) {
                                    : forced::LinearSolverOptions::Kind::automatic;
     equations.set_linear_solver(so);
 
-    // The variable scaling and options of cmd_frf.cpp.
-    const auto& cn = c.continuation;
-    double motion = 0.0;
-    for (int i = 0; i <= 40; ++i) {
-      const double f = cn.frequency_start_hz + (cn.frequency_end_hz - cn.frequency_start_hz) * i / 40.0;
-      motion = std::max(motion, equations.linear_motion(f).lpNorm<Eigen::Infinity>());
-    }
-    double contact_scale = 0.0;
-    for (const auto& p : model.pairs)
-      contact_scale = std::max({contact_scale, p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness,
-                                std::abs(p.normal_preload) / p.normal_stiffness});
-    const double x_scale = motion > 0 ? motion / 20.0 : std::max(contact_scale, 1e-12);
-    continuation::ArclengthOptions ao;
-    ao.lambda_start = cn.frequency_start_hz;
-    ao.lambda_end = cn.frequency_end_hz;
-    ao.x_scale = Eigen::VectorXd::Constant(equations.size(), x_scale);
-    ao.initial_step = cn.initial_step;
-    ao.max_step = std::max(1.0, std::abs(cn.frequency_end_hz - cn.frequency_start_hz) / (200.0 * cn.initial_step));
-    ao.max_points = cn.max_points;
-    ao.tolerance = c.hbm.tolerance;
+    // The variable scaling, options and start of cmd_frf.cpp.
+    const continuation::ArclengthOptions ao = app::arclength_options(c, model, equations);
 
     log::Stopwatch clock;
-    Eigen::VectorXd start = equations.stuck_solution(ao.lambda_start);
-    std::string how = "stuck";
-    if (continuation::newton_fixed(equations, start, ao.lambda_start, ao) < 0) {
-      how = "free";
-      start = equations.linear_motion(ao.lambda_start);
-    }
-    if (how == "free" && continuation::newton_fixed(equations, start, ao.lambda_start, ao) < 0) {
-      // Harmonic stepping as in cmd_frf.cpp: H = 1, then one harmonic at a time from zero.
-      how = "harmonic_stepping";
-      Eigen::VectorXd prev;
-      int prev_h = 0;
-      for (int h = 1; h <= eo.n_harmonics; ++h) {
-        hbm::ContactEvaluatorOptions step_options = eo;
-        step_options.n_harmonics = h;
-        hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
-        forced::ReducedEquations step_equations(*model.linear, step_evaluator);
-        continuation::ArclengthOptions o = ao;
-        o.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
-        Eigen::VectorXd w;
-        if (h == 1) {
-          w = step_equations.stuck_solution(ao.lambda_start);
-          if (continuation::newton_fixed(step_equations, w, ao.lambda_start, o) < 0) {
-            w = step_equations.stuck_solution(ao.lambda_start);
-            if (step_equations.solve_by_excitation_homotopy(ao.lambda_start, o, w).status !=
-                continuation::BranchStatus::kReachedEnd)
-              break;
-          }
-        } else {
-          w = Eigen::VectorXd::Zero(step_equations.size());
-          const auto& lo = step_evaluator.pair_layout();
-          const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
-          for (int p = 0; p < step_evaluator.n_pairs(); ++p)
-            for (int d = 0; d < lo.n_directions(); ++d)
-              for (int n = 0; n <= prev_h; ++n)
-                for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
-                  if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
-                  w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
-                }
-          if (continuation::newton_fixed(step_equations, w, ao.lambda_start, o) < 0) break;
-        }
-        prev = w;
-        prev_h = h;
-      }
-      if (prev_h == eo.n_harmonics) {
-        start = prev;
-      } else {
-        how = "homotopy";
-        start = equations.stuck_solution(ao.lambda_start);
-        if (equations.solve_by_excitation_homotopy(ao.lambda_start, ao, start).status !=
-            continuation::BranchStatus::kReachedEnd)
-          throw NumericalError("no start point");
-      }
-    }
+    std::string how;
+    const Eigen::VectorXd start = app::find_start(model, eo, equations, ao, ao.lambda_start, how);
+    std::replace(how.begin(), how.end(), ' ', '_');  // one key=value token in the output
     const double start_seconds = clock.seconds();
 
     std::vector<double> e_contact, e_full, at;

@@ -223,19 +223,8 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
   return o;
 }
 
-int cmd_frf(Context& ctx) {
-  const io::Case& c = ctx.config;
-  if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return frf_auto(ctx);
-  log::Stopwatch clock;
-  ForcedModel model = c.structure.type == "lumped" ? make_lumped_model(c) : make_sector_model(ctx);
-  for (const auto& p : model.pairs) {
-    std::vector<std::string> errors;
-    if (!p.validate(*contact::parse_model(c.contact.model), &errors)) throw InputError(c.file.string() + ": " + errors.front());
-  }
-  const hbm::ContactEvaluatorOptions eo = evaluator_options(c, ctx.threads);
-  hbm::ContactEvaluator evaluator(eo, model.pairs);
-  forced::ReducedEquations equations(*model.linear, evaluator);
-
+continuation::ArclengthOptions arclength_options(const io::Case& c, const ForcedModel& model,
+                                                 const forced::ReducedEquations& equations) {
   // Scaled variables: the free linear contact motion over the range sets the unit of W,
   // so that a resonance peak spans some tens of arclength units (PHYSICS.md section 7).
   const auto& cn = c.continuation;
@@ -258,77 +247,96 @@ int cmd_frf(Context& ctx) {
   ao.max_step = std::max(1.0, std::abs(cn.frequency_end_hz - cn.frequency_start_hz) / (200.0 * cn.initial_step));
   ao.max_points = cn.max_points;
   ao.tolerance = c.hbm.tolerance;
+  return ao;
+}
+
+Eigen::VectorXd find_start(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                           forced::ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
+                           std::string& how) {
+  const double x_scale = ao.x_scale[0];
+  how = "stuck contact";
+  Eigen::VectorXd start = equations.stuck_solution(f);
+  if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
+  how = "free response";
+  start = equations.linear_motion(f);
+  if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
+  if (eo.n_harmonics > 1) {
+    // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
+    // each new harmonic starting at zero (higher harmonics are small corrections).
+    log::info("frf: start point at " + io::format_number(f) + " Hz by harmonic stepping (H = 1 .. " +
+              std::to_string(eo.n_harmonics) + ")");
+    Eigen::VectorXd prev;
+    int prev_h = 0;
+    for (int h = 1; h <= eo.n_harmonics; ++h) {
+      hbm::ContactEvaluatorOptions step_options = eo;
+      step_options.n_harmonics = h;
+      hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
+      forced::ReducedEquations step_equations(*model.linear, step_evaluator);
+      continuation::ArclengthOptions so = ao;
+      so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
+      Eigen::VectorXd w;
+      if (h == 1) {
+        w = step_equations.stuck_solution(f);
+        if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
+          w = step_equations.stuck_solution(f);
+          if (step_equations.solve_by_excitation_homotopy(f, so, w).status != continuation::BranchStatus::kReachedEnd)
+            break;
+        }
+      } else {
+        w = Eigen::VectorXd::Zero(step_equations.size());
+        const auto& lo = step_evaluator.pair_layout();
+        const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
+        for (int p = 0; p < step_evaluator.n_pairs(); ++p)
+          for (int d = 0; d < lo.n_directions(); ++d)
+            for (int n = 0; n <= prev_h; ++n)
+              for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
+                if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
+                w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
+              }
+        if (continuation::newton_fixed(step_equations, w, f, so) < 0) break;
+      }
+      prev = w;
+      prev_h = h;
+    }
+    if (prev_h == eo.n_harmonics) {
+      how = "harmonic stepping";
+      return prev;
+    }
+  }
+  how = "excitation homotopy";
+  start = equations.stuck_solution(f);
+  const continuation::Branch h = equations.solve_by_excitation_homotopy(f, ao, start);
+  if (h.status != continuation::BranchStatus::kReachedEnd)
+    throw NumericalError("no solution at the start frequency " + io::format_number(f) +
+                         " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
+                         h.message);
+  log::info("frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) + " points)");
+  return start;
+}
+
+int cmd_frf(Context& ctx) {
+  const io::Case& c = ctx.config;
+  if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return frf_auto(ctx);
+  log::Stopwatch clock;
+  ForcedModel model = c.structure.type == "lumped" ? make_lumped_model(c) : make_sector_model(ctx);
+  for (const auto& p : model.pairs) {
+    std::vector<std::string> errors;
+    if (!p.validate(*contact::parse_model(c.contact.model), &errors)) throw InputError(c.file.string() + ": " + errors.front());
+  }
+  const hbm::ContactEvaluatorOptions eo = evaluator_options(c, ctx.threads);
+  hbm::ContactEvaluator evaluator(eo, model.pairs);
+  forced::ReducedEquations equations(*model.linear, evaluator);
+
+  const continuation::ArclengthOptions ao = arclength_options(c, model, equations);
+  const double x_scale = ao.x_scale[0];
 
   std::vector<forced::PointResult> results;
   std::vector<int> iterations;
   log::info("frf: " + model.linear->describe() + ", " + std::to_string(evaluator.n_pairs()) + " contact pairs, " +
             std::to_string(equations.size()) + " unknowns (H = " + std::to_string(c.hbm.harmonics) +
             ", N = " + std::to_string(c.hbm.time_samples) + ", " + c.contact.model + ", " + c.hbm.jacobian + " Jacobian)");
-  // Start at frequency f: Newton from the stuck-contact solution; where it fails (Newton
-  // cycling between contact states), from the free response, then harmonic stepping, then
-  // continuation in the excitation level from the preload-only state. `how` says which.
-  auto start_at = [&](double f, std::string& how) -> Eigen::VectorXd {
-    how = "stuck contact";
-    Eigen::VectorXd start = equations.stuck_solution(f);
-    if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
-    how = "free response";
-    start = equations.linear_motion(f);
-    if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
-    if (eo.n_harmonics > 1) {
-      // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
-      // each new harmonic starting at zero (higher harmonics are small corrections).
-      log::info("frf: start point at " + io::format_number(f) + " Hz by harmonic stepping (H = 1 .. " +
-                std::to_string(eo.n_harmonics) + ")");
-      Eigen::VectorXd prev;
-      int prev_h = 0;
-      for (int h = 1; h <= eo.n_harmonics; ++h) {
-        hbm::ContactEvaluatorOptions step_options = eo;
-        step_options.n_harmonics = h;
-        hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
-        forced::ReducedEquations step_equations(*model.linear, step_evaluator);
-        continuation::ArclengthOptions so = ao;
-        so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
-        Eigen::VectorXd w;
-        if (h == 1) {
-          w = step_equations.stuck_solution(f);
-          if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
-            w = step_equations.stuck_solution(f);
-            if (step_equations.solve_by_excitation_homotopy(f, so, w).status != continuation::BranchStatus::kReachedEnd)
-              break;
-          }
-        } else {
-          w = Eigen::VectorXd::Zero(step_equations.size());
-          const auto& lo = step_evaluator.pair_layout();
-          const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
-          for (int p = 0; p < step_evaluator.n_pairs(); ++p)
-            for (int d = 0; d < lo.n_directions(); ++d)
-              for (int n = 0; n <= prev_h; ++n)
-                for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
-                  if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
-                  w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
-                }
-          if (continuation::newton_fixed(step_equations, w, f, so) < 0) break;
-        }
-        prev = w;
-        prev_h = h;
-      }
-      if (prev_h == eo.n_harmonics) {
-        how = "harmonic stepping";
-        return prev;
-      }
-    }
-    how = "excitation homotopy";
-    start = equations.stuck_solution(f);
-    const continuation::Branch h = equations.solve_by_excitation_homotopy(f, ao, start);
-    if (h.status != continuation::BranchStatus::kReachedEnd)
-      throw NumericalError("no solution at the start frequency " + io::format_number(f) +
-                           " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
-                           h.message);
-    log::info("frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) + " points)");
-    return start;
-  };
   std::string how;
-  const Eigen::VectorXd start = start_at(ao.lambda_start, how);
+  const Eigen::VectorXd start = find_start(model, eo, equations, ao, ao.lambda_start, how);
   ctx.report.section("frf")["start"] = how;
   int piece = 0;
   std::vector<int> pieces;
@@ -370,7 +378,7 @@ int cmd_frf(Context& ctx) {
     piece = 1;
     try {
       std::string back_how;
-      const Eigen::VectorXd back_start = start_at(back.lambda_start, back_how);
+      const Eigen::VectorXd back_start = find_start(model, eo, equations, ao, back.lambda_start, back_how);
       ctx.report.section("frf")["start_second_piece"] = back_how;
       const continuation::Branch second = continuation::trace(equations, back_start, back, on_point);
       points.insert(points.end(), second.points.begin(), second.points.end());
