@@ -13,7 +13,7 @@ case "$mode" in demo|test|build) ;; *) echo "usage: tools/setup.sh [demo|test|bu
 
 packages=(
   cmake make g++ pkg-config
-  libeigen3-dev libspectra-dev libsuitesparse-dev libfftw3-dev
+  libeigen3-dev libspectra-dev libsuitesparse-dev libopenblas0-pthread libfftw3-dev
   libgmsh-dev gmsh
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev

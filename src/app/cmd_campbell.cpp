@@ -33,6 +33,7 @@
 
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
+#include "app/workers.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
@@ -145,12 +146,10 @@ int cmd_campbell(Context& ctx) {
               fixed(peak_top / 1e6, 1) + " MPa (element " + std::to_string(ops.peak.element) +
               "), largest displacement " + fixed(tip_top * 1e3, 3) + " mm (" + fixed(prestress_seconds, 2) + " s)");
 
-    const int workers = std::clamp(ctx.threads > 0 ? ctx.threads : static_cast<int>(std::thread::hardware_concurrency()),
-                                   1, static_cast<int>(canonical.size()));
-    std::atomic<std::size_t> next{0};
+    const int workers = worker_count(ctx.threads, static_cast<int>(canonical.size()));
     std::mutex lock;
-    auto work = [&] {
-      for (std::size_t k = next++; k < canonical.size(); k = next++) {
+    parallel_for(static_cast<int>(canonical.size()), workers, [&](int k) {
+      {
         const int h = canonical[k];
         Sweep s;
         s.f.assign(np, Eigen::VectorXd());
@@ -207,11 +206,7 @@ int cmd_campbell(Context& ctx) {
         std::lock_guard<std::mutex> g(lock);
         sweeps[h] = std::move(s);
       }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < workers; ++t) pool.emplace_back(work);
-    work();
-    for (auto& t : pool) t.join();
+    });
 
     nlohmann::json per_h = nlohmann::json::array();
     double total = 0.0;

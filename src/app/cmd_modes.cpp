@@ -15,6 +15,7 @@
 
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
+#include "app/workers.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "fe/assembly.hpp"
@@ -74,6 +75,7 @@ std::string modes_key(const std::string& km_key, int h, const modal::ModalOption
   hs.add(o.shift);
   hs.add(o.tolerance);
   hs.add(o.residual_tolerance);
+  hs.add(modal::to_string(o.method));
   return hs.hex();
 }
 
@@ -130,6 +132,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     throw InputError(location(c, "material.youngs_modulus") +
                      ": [material] violates: youngs_modulus > 0, -1 < poisson_ratio < 0.5, density > 0");
   model.options.modes = c.modal.modes;
+  model.options.method = c.modal.eigensolver == "spectra" ? modal::EigenMethod::Spectra : modal::EigenMethod::Block;
   std::vector<std::string> errors;
   if (!model.options.validate(&errors)) throw InputError(location(c, "modal.modes") + ": modal." + errors.front());
 
@@ -209,12 +212,10 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     report["reduced_dofs"] = sector.n_reduced();
     // Harmonic indices are independent: solve them in parallel (each worker holds one
     // factorization; CHOLMOD, Spectra and Eigen objects are not shared).
-    const int workers = std::clamp(ctx.threads > 0 ? ctx.threads : static_cast<int>(std::thread::hardware_concurrency()),
-                                   1, static_cast<int>(to_solve.size()));
-    std::atomic<std::size_t> next{0};
+    const int workers = worker_count(ctx.threads, static_cast<int>(to_solve.size()));
     std::mutex lock;
-    auto work = [&] {
-      for (std::size_t i = next++; i < to_solve.size(); i = next++) {
+    parallel_for(static_cast<int>(to_solve.size()), workers, [&](int i) {
+      {
         const int h = to_solve[i];
         log::Stopwatch watch;
         HarmonicOutcome o;
@@ -240,11 +241,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
         std::lock_guard<std::mutex> g(lock);
         outcome[h] = std::move(o);
       }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < workers; ++t) pool.emplace_back(work);
-    work();
-    for (auto& t : pool) t.join();
+    });
   }
 
   bool all_reused = true;

@@ -19,6 +19,7 @@
 #include "app/context.hpp"
 #include "app/frf_curves.hpp"
 #include "app/modal_stage.hpp"
+#include "app/workers.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
@@ -60,15 +61,15 @@ double thread_cpu_seconds() {
 /// quietly, one line each; fills status, message, peak, points and seconds. Returns the
 /// number of workers used.
 int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<StudyPoint>& points) {
-  const int workers = std::max(1, std::min<int>(ctx.threads > 0 ? ctx.threads : static_cast<int>(std::thread::hardware_concurrency()),
-                                                 static_cast<int>(points.size())));
+  const int workers = worker_count(ctx.threads, static_cast<int>(points.size()));
   log::info("study: " + std::to_string(points.size()) + " points on " + std::to_string(workers) + " workers");
   const bool verbose = log::verbose();
   log::set_verbose(false);  // points run quietly; one line each below
-  std::atomic<std::size_t> next{0};
   std::mutex out;
-  auto work = [&] {
-    for (std::size_t i; (i = next++) < points.size();) {
+  // Serial BLAS even with one worker: a point's cost is its thread's CPU time.
+  linalg::SerialBlasScope serial;
+  parallel_for(static_cast<int>(points.size()), workers, [&](int i) {
+    {
       Context pc;
       pc.config = cases[i];
       pc.out_dir = ctx.out_dir / points[i].folder;
@@ -111,13 +112,9 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
         std::cerr << s.str();
       }
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 0; t < workers; ++t) pool.emplace_back(work);
-  for (auto& t : pool) t.join();
+  });
   log::set_verbose(verbose);
   return workers;
-
 }
 
 

@@ -441,6 +441,7 @@ void read_all(Reader& r, Case& c) {
     return v >= 0 && v < 1 ? std::nullopt : std::optional<std::string>("0 <= damping_ratio < 1");
   });
   mo.residual_flexibility = r.boolean("modal.residual_flexibility");
+  mo.eigensolver = r.string("modal.eigensolver", {"block", "spectra"});
 
   auto& ca = c.campbell;
   ca.speed_rpm = r.numbers("campbell.speed_rpm");

@@ -49,6 +49,7 @@ struct ModalSection {
   std::vector<int> harmonic_indices;    ///< when not all
   double damping_ratio = 0.001;
   bool residual_flexibility = true;
+  std::string eigensolver = "block";    ///< "block" (block Krylov-Schur) | "spectra" (Spectra's Lanczos)
 };
 
 struct CampbellSection {

@@ -30,11 +30,13 @@ template <typename Scalar>
 struct CholmodFactor<Scalar>::Impl {
   Decomposition<Scalar> llt;
   // x = sys2(sys1(b)) with CHOLMOD's partial solves (int API, as Eigen uses for int indices).
-  void two_step(int sys1, int sys2, const Scalar* b, Scalar* x, Eigen::Index n) {
+  // b and x hold ncol columns of length n, stored contiguously (leading dimension n).
+  void two_step(int sys1, int sys2, const Scalar* b, Scalar* x, Eigen::Index n, Eigen::Index ncol = 1) {
     cholmod_common& c = llt.cholmod();
     cholmod_dense B;
-    B.nrow = B.nzmax = B.d = static_cast<std::size_t>(n);
-    B.ncol = 1;
+    B.nrow = B.d = static_cast<std::size_t>(n);
+    B.ncol = static_cast<std::size_t>(ncol);
+    B.nzmax = B.nrow * B.ncol;
     B.x = const_cast<Scalar*>(b);
     B.z = nullptr;
     B.xtype = std::is_same_v<Scalar, double> ? CHOLMOD_REAL : CHOLMOD_COMPLEX;
@@ -45,7 +47,7 @@ struct CholmodFactor<Scalar>::Impl {
       if (t) cholmod_free_dense(&t, &c);
       throw std::runtime_error("CHOLMOD partial solve failed");
     }
-    std::copy_n(static_cast<const Scalar*>(u->x), n, x);
+    std::copy_n(static_cast<const Scalar*>(u->x), n * ncol, x);
     cholmod_free_dense(&t, &c);
     cholmod_free_dense(&u, &c);
   }
@@ -125,6 +127,26 @@ void CholmodFactor<Scalar>::solve_backward(const Scalar* b, Scalar* x) const {
   SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_backward without a valid factor");
   SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
   impl_->two_step(CHOLMOD_Lt, CHOLMOD_Pt, b, x, rows_);
+}
+
+template <typename Scalar>
+typename CholmodFactor<Scalar>::Matrix CholmodFactor<Scalar>::solve_forward(const Matrix& b) const {
+  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_forward without a valid factor");
+  SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
+  SHROUDSIM_CHECK(b.rows() == rows_, "CholmodFactor::solve_forward: right-hand side has the wrong size");
+  Matrix x(rows_, b.cols());
+  if (b.cols() > 0) impl_->two_step(CHOLMOD_P, CHOLMOD_L, b.data(), x.data(), rows_, b.cols());
+  return x;
+}
+
+template <typename Scalar>
+typename CholmodFactor<Scalar>::Matrix CholmodFactor<Scalar>::solve_backward(const Matrix& b) const {
+  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_backward without a valid factor");
+  SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
+  SHROUDSIM_CHECK(b.rows() == rows_, "CholmodFactor::solve_backward: right-hand side has the wrong size");
+  Matrix x(rows_, b.cols());
+  if (b.cols() > 0) impl_->two_step(CHOLMOD_Lt, CHOLMOD_Pt, b.data(), x.data(), rows_, b.cols());
+  return x;
 }
 
 template <typename Scalar>

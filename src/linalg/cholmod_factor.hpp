@@ -58,6 +58,10 @@ class CholmodFactor {
   /// Used for the symmetric form L^{-1} P M P^T L^{-H} of a generalized eigenproblem.
   void solve_forward(const Scalar* b, Scalar* x) const;
   void solve_backward(const Scalar* b, Scalar* x) const;
+  /// The half solves for several right-hand sides (columns) at once: CHOLMOD's supernodal
+  /// solve then runs BLAS-3 kernels, a block of 16 columns costing a few single solves.
+  Matrix solve_forward(const Matrix& b) const;
+  Matrix solve_backward(const Matrix& b) const;
 
   FactorStatus status() const { return status_; }
   Eigen::Index rows() const { return rows_; }

@@ -17,6 +17,15 @@
 // physical modes (M-orthonormalised, Rayleigh-Ritz when a group holds more than one
 // physical mode). Each mode is returned once.
 //
+// The default method for large problems is a block Krylov-Schur iteration (thick-restarted
+// block Lanczos with full reorthogonalization) on the same operator, in the problem's own
+// scalar type: complex Hermitian problems need no 2n embedding and no doubled eigenvalues,
+// and the operator is applied to blocks of `block_size` vectors (CHOLMOD's supernodal
+// solve runs BLAS-3 kernels on a block; single-vector solves are memory bound). At 2e5
+// DOFs, complex, it needs a third of the solve time of Spectra's Lanczos on the embedding
+// (92 vectors against 130, each cheaper). Spectra stays selectable (ModalOptions::method)
+// and the tests compare the two.
+//
 // Every returned mode is checked: ||K phi - w^2 M phi|| <= residual_tolerance * ||K phi||.
 // Failure (factorization, Spectra not converging, residual too large, too few modes) is
 // reported in ModalReport (status + message), never by silently returning modes.
@@ -34,12 +43,21 @@ namespace shroudsim::modal {
 
 using linalg::Complex;
 
+enum class EigenMethod {
+  Block,   ///< block Krylov-Schur on the shift-invert operator (default)
+  Spectra  ///< Spectra's SymEigsSolver (implicitly restarted Lanczos; 2n embedding for complex)
+};
+std::string to_string(EigenMethod method);
+
 struct ModalOptions {
   int modes = 50;                  ///< lowest modes wanted per problem (>= 1)
+  EigenMethod method = EigenMethod::Block;
+  int block_size = 0;              ///< Block: vectors per block; 0: 4
   double shift = 0.0;              ///< sigma [(rad/s)^2]; 0 factors K itself (kept for static solves).
                                    ///< Use sigma < 0 for an unclamped (singular) K.
-  int ncv = 0;                     ///< Lanczos basis size; 0: max(2 nev + 1, nev + 20)
-  int max_restarts = 1000;         ///< Spectra maxit
+  int ncv = 0;                     ///< basis size; 0: Spectra max(2 nev + 1, nev + 20),
+                                   ///< Block max(3 modes, modes + 3 block_size)
+  int max_restarts = 1000;         ///< Spectra maxit; Block: thick restarts allowed
   double tolerance = 1e-10;        ///< Spectra's relative tolerance on the Ritz values
   double residual_tolerance = 1e-6;  ///< accepted ||K phi - w^2 M phi|| / ||K phi||
   linalg::FactorMethod factor_method = linalg::FactorMethod::Supernodal;
@@ -70,11 +88,11 @@ std::string to_string(ModalStatus status);
 struct ModalReport {
   ModalStatus status = ModalStatus::Converged;
   std::string message;            ///< empty when converged
-  std::string method;             ///< "spectra-real", "spectra-complex-2n" or "dense"
+  std::string method;             ///< "block-real", "block-complex", "spectra-real", "spectra-complex-2n" or "dense"
   int spectra_info = 0;           ///< Spectra::CompInfo as int (0 = Successful)
   int requested_eigenvalues = 0;  ///< nev asked of Spectra
   int converged_eigenvalues = 0;  ///< nconv
-  int iterations = 0;             ///< Spectra restarts
+  int iterations = 0;             ///< restarts (Spectra), block steps (Block)
   int operations = 0;             ///< operator applications (solves)
   int mass_products = 0;          ///< products with M (one per operator application)
   double max_residual = 0.0;      ///< max relative residual of the returned modes

@@ -1,0 +1,58 @@
+#pragma once
+// The worker pool of the commands that run independent jobs in parallel (harmonic indices
+// in `modes` and `campbell`, points in `study`).
+//
+//   const int workers = app::worker_count(ctx.threads, jobs);
+//   app::parallel_for(jobs, workers, [&](int i) { ...job i... });
+//
+// Each index runs once, on one of `workers` threads (the calling thread included), taken in
+// increasing order. With more than one worker the BLAS runs on one thread meanwhile
+// (linalg::SerialBlasScope): OpenBLAS's own threads on top of the workers oversubscribe the
+// cores. A job should catch its own exceptions; one that escapes is rethrown after all
+// workers have finished (the first one only).
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "linalg/blas.hpp"
+
+namespace shroudsim::app {
+
+/// `requested` workers (0: one per hardware thread), at least 1 and at most `jobs`.
+inline int worker_count(int requested, int jobs) {
+  const int want = requested > 0 ? requested : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::max(1, std::min(want, jobs));
+}
+
+template <typename Job>
+void parallel_for(int jobs, int workers, Job&& job) {
+  std::atomic<int> next{0};
+  std::mutex lock;
+  std::exception_ptr failure;
+  auto work = [&] {
+    for (int i; (i = next++) < jobs;) {
+      try {
+        job(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> g(lock);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  if (workers <= 1) {
+    work();
+  } else {
+    linalg::SerialBlasScope serial;
+    std::vector<std::thread> pool;
+    for (int t = 1; t < workers; ++t) pool.emplace_back(work);
+    work();
+    for (auto& t : pool) t.join();
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace shroudsim::app
