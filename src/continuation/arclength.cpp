@@ -14,6 +14,14 @@ bool ParametricResidual::solve_augmented(const Eigen::MatrixXd& A, const Eigen::
   return d.allFinite();
 }
 
+bool ParametricResidual::linearize(const Eigen::VectorXd&, double, Eigen::VectorXd&, Eigen::VectorXd*) {
+  return false;  // only matrix-free residuals linearize
+}
+
+bool ParametricResidual::solve_bordered(const BorderedMatrix&, const Eigen::VectorXd&, Eigen::VectorXd&) {
+  return false;
+}
+
 const char* to_string(BranchStatus status) {
   switch (status) {
     case BranchStatus::kReachedEnd: return "reached_end";
@@ -63,19 +71,30 @@ class Scaled {
   Eigen::VectorXd x_of(const Eigen::VectorXd& y) const { return y.head(n()).cwiseProduct(xs_); }
   double lambda_of(const Eigen::VectorXd& y) const { return y[n()] * o_.lambda_scale; }
 
-  /// rs = scaled residual; when Js is not null, Js = d(rs)/d(y_s), n x (n+1).
-  bool evaluate(const Eigen::VectorXd& y, Eigen::VectorXd& rs, Eigen::MatrixXd* Js) {
+  /// The linearization at a point: the dense scaled Jacobian Js = d(rs)/d(y_s), n x (n+1),
+  /// or, for a matrix-free residual, only its last column (the scaled dR/dlambda).
+  struct Linearization {
+    Eigen::MatrixXd Js;
+    Eigen::VectorXd column;
+  };
+
+  /// rs = scaled residual; when lin is not null, the linearization there.
+  bool evaluate(const Eigen::VectorXd& y, Eigen::VectorXd& rs, Linearization* lin) {
     const Eigen::VectorXd x = x_of(y);
     const double lambda = lambda_of(y);
     Eigen::VectorXd r;
-    Eigen::MatrixXd J;
     Eigen::VectorXd dl;
     const bool analytic_lambda = r_.has_lambda_derivative();
+    const bool matrix_free = lin && r_.matrix_free();
     ++*evaluations_;
-    if (!r_.evaluate(x, lambda, r, Js ? &J : nullptr, Js && analytic_lambda ? &dl : nullptr)) return false;
+    if (matrix_free) {
+      if (!r_.linearize(x, lambda, r, analytic_lambda ? &dl : nullptr)) return false;
+    } else if (!r_.evaluate(x, lambda, r, lin ? &J_ : nullptr, lin && analytic_lambda ? &dl : nullptr)) {
+      return false;
+    }
     if (!r.allFinite()) return false;
     rs = r.cwiseQuotient(rs_);
-    if (!Js) return true;
+    if (!lin) return true;
     if (!analytic_lambda) {
       const double h = 1e-6 * (std::abs(lambda) + o_.lambda_scale);
       Eigen::VectorXd rp, rm;
@@ -84,10 +103,22 @@ class Scaled {
         return false;
       dl = (rp - rm) / (2 * h);
     }
-    Js->resize(n(), n() + 1);
-    Js->leftCols(n()) = rs_.cwiseInverse().asDiagonal() * J * xs_.asDiagonal();
-    Js->col(n()) = dl.cwiseQuotient(rs_) * o_.lambda_scale;
-    return Js->allFinite();
+    lin->column = dl.cwiseQuotient(rs_) * o_.lambda_scale;
+    if (matrix_free) return lin->column.allFinite();
+    lin->Js.resize(n(), n() + 1);
+    lin->Js.leftCols(n()) = rs_.cwiseInverse().asDiagonal() * J_ * xs_.asDiagonal();
+    lin->Js.col(n()) = lin->column;
+    return lin->Js.allFinite();
+  }
+
+  /// Solves [Js; row^T] d = b with the linearization of the last evaluate() that gave one.
+  bool solve(const Linearization& lin, const Eigen::VectorXd& row, const Eigen::VectorXd& b, Eigen::VectorXd& d) {
+    if (r_.matrix_free()) return r_.solve_bordered(BorderedMatrix{rs_, xs_, lin.column, row}, b, d);
+    const int m = n();
+    A_.resize(m + 1, m + 1);
+    A_.topRows(m) = lin.Js;
+    A_.row(m) = row.transpose();
+    return r_.solve_augmented(A_, b, d);
   }
 
   ParametricResidual& residual() { return r_; }
@@ -97,21 +128,19 @@ class Scaled {
   const ArclengthOptions& o_;
   int* evaluations_;
   Eigen::VectorXd xs_, rs_;
+  Eigen::MatrixXd J_, A_;  // buffers kept across evaluations (n x n, (n+1) x (n+1))
 };
 
 /// Unit tangent at y: [Js; row] t = e_{n+1}, oriented along `orient`.
 bool tangent_at(Scaled& s, const Eigen::VectorXd& y, const Eigen::VectorXd& row, const Eigen::VectorXd& orient,
                 Eigen::VectorXd& t) {
   Eigen::VectorXd rs;
-  Eigen::MatrixXd Js;
-  if (!s.evaluate(y, rs, &Js)) return false;
+  Scaled::Linearization lin;
+  if (!s.evaluate(y, rs, &lin)) return false;
   const int n = s.n();
-  Eigen::MatrixXd A(n + 1, n + 1);
-  A.topRows(n) = Js;
-  A.row(n) = row.transpose();
   Eigen::VectorXd b = Eigen::VectorXd::Zero(n + 1);
   b[n] = 1.0;
-  if (!s.residual().solve_augmented(A, b, t)) return false;
+  if (!s.solve(lin, row, b, t)) return false;
   const double norm = t.norm();
   if (!(norm > 0) || !std::isfinite(norm)) return false;
   t /= norm;
@@ -124,13 +153,13 @@ int corrector(Scaled& s, Eigen::VectorXd& y, const Eigen::VectorXd& t, const Eig
               const ArclengthOptions& o, double& final_norm) {
   const int n = s.n();
   Eigen::VectorXd rs, b(n + 1), d, y_prev, rs_try;
-  Eigen::MatrixXd Js, A(n + 1, n + 1);
+  Scaled::Linearization lin;
   double first = -1.0, prev_norm = 0.0;
   auto norm_at = [&](const Eigen::VectorXd& yy, const Eigen::VectorXd& r) {
     return std::max(r.lpNorm<Eigen::Infinity>(), std::abs(t.dot(yy - y_pred)));
   };
   for (int it = 0; it <= o.max_newton_iterations; ++it) {
-    if (!s.evaluate(y, rs, &Js)) return -1;
+    if (!s.evaluate(y, rs, &lin)) return -1;
     double norm = norm_at(y, rs);
     // A full step that did not reduce the residual (Newton cycling between the pieces of a
     // nonsmooth residual, e.g. a sample switching between stick and slip) is cut back along
@@ -141,7 +170,7 @@ int corrector(Scaled& s, Eigen::VectorXd& y, const Eigen::VectorXd& t, const Eig
         if (!s.evaluate(y_try, rs_try, nullptr)) break;
         if (norm_at(y_try, rs_try) < prev_norm) {
           y = y_try;
-          if (!s.evaluate(y, rs, &Js)) return -1;
+          if (!s.evaluate(y, rs, &lin)) return -1;
           norm = norm_at(y, rs);
           break;
         }
@@ -152,11 +181,9 @@ int corrector(Scaled& s, Eigen::VectorXd& y, const Eigen::VectorXd& t, const Eig
     final_norm = norm;
     if (norm <= o.tolerance) return it;
     if (it == o.max_newton_iterations || norm > 1e6 * std::max(first, o.tolerance)) return -1;
-    A.topRows(n) = Js;
-    A.row(n) = t.transpose();
     b.head(n) = -rs;
     b[n] = -constraint;
-    if (!s.residual().solve_augmented(A, b, d)) return -1;
+    if (!s.solve(lin, t, b, d)) return -1;
     y_prev = y;
     prev_norm = norm;
     y += d;

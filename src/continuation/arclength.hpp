@@ -32,6 +32,18 @@
 
 namespace shroudsim::continuation {
 
+/// The (n+1) x (n+1) bordered Newton matrix of the continuation, in its scaled variables,
+/// given without forming it:
+///     A = [ diag(1 / r_scale) J diag(x_scale)   column ]
+///         [ row^T                                      ]
+/// J = dR/dx at the last linearize() point, column = the scaled dR/dlambda (n), row (n + 1).
+struct BorderedMatrix {
+  const Eigen::VectorXd& r_scale;
+  const Eigen::VectorXd& x_scale;
+  const Eigen::VectorXd& column;
+  const Eigen::VectorXd& row;
+};
+
 /// R(x, lambda): R^n x R -> R^n.
 class ParametricResidual {
  public:
@@ -47,6 +59,17 @@ class ParametricResidual {
   /// Solves the (n+1) augmented Newton system A d = b. The default is a dense LU;
   /// a residual with structure (e.g. a low-rank update) may do better.
   virtual bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d);
+
+  /// Matrix-free residuals (matrix_free() true) never give the continuation a dense J:
+  /// linearize() evaluates r (and dR/dlambda when has_lambda_derivative()) and keeps what
+  /// products with J need; solve_bordered() solves A d = b with the bordered matrix at the
+  /// last linearize() point (evaluations without linearizing in between do not move it).
+  /// The continuation then calls these instead of evaluate() with J and solve_augmented():
+  /// for large n the dense n x n J, its scaled copies and their O(n^2) traffic per Newton
+  /// iteration are what cost.
+  virtual bool matrix_free() const { return false; }
+  virtual bool linearize(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd& r, Eigen::VectorXd* dr_dlambda);
+  virtual bool solve_bordered(const BorderedMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& d);
 };
 
 struct ArclengthOptions {

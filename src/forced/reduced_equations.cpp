@@ -144,7 +144,11 @@ void ReducedEquations::apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen
 }
 
 void ReducedEquations::jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks, Eigen::MatrixXd& J) {
-  const Harmonics& hs = harmonics(frequency_hz, false);
+  jacobian_from(harmonics(frequency_hz, false).g, blocks, J);
+}
+
+void ReducedEquations::jacobian_from(const std::vector<Eigen::MatrixXcd>& g_n, const std::vector<Eigen::MatrixXd>& blocks,
+                                     Eigen::MatrixXd& J) {
   log::Stopwatch clock;
   const auto& layout = contacts_.pair_layout();
   const int h = layout.n_harmonics(), pairs = contacts_.n_pairs(), block = layout.size(), nd = n_directions_;
@@ -157,7 +161,7 @@ void ReducedEquations::jacobian(double frequency_hz, const std::vector<Eigen::Ma
     // row of each local index.
     gr.resize(m, m);
     rows.resize(static_cast<std::size_t>(m));
-    const Eigen::MatrixXcd& g = hs.g[static_cast<std::size_t>(n)];
+    const Eigen::MatrixXcd& g = g_n[static_cast<std::size_t>(n)];
     for (int q = 0; q < pairs; ++q)
       for (int e = 0; e < nd; ++e) {
         const int lq = (q * nd + e) * parts;
@@ -208,11 +212,28 @@ Eigen::MatrixXd ReducedEquations::dense_jacobian(double frequency_hz, const std:
 
 bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r,
                                 Eigen::MatrixXd* J, Eigen::VectorXd* dr_dlambda) {
+  return evaluate_impl(w, frequency_hz, r, J, dr_dlambda, false);
+}
+
+bool ReducedEquations::matrix_free() const {
+  return solver_.kind == LinearSolverOptions::Kind::krylov ||
+         (solver_.kind == LinearSolverOptions::Kind::automatic && size() + 1 >= solver_.krylov_min_size);
+}
+
+bool ReducedEquations::linearize(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r,
+                                 Eigen::VectorXd* dr_dlambda) {
+  return evaluate_impl(w, frequency_hz, r, nullptr, dr_dlambda, true);
+}
+
+bool ReducedEquations::evaluate_impl(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r,
+                                     Eigen::MatrixXd* J, Eigen::VectorXd* dr_dlambda, bool linearize) {
   if (!w.allFinite() || !std::isfinite(frequency_hz) || frequency_hz <= 0) return false;
   // The continuation evaluates its converged point once more for the tangent: a repeat.
+  // (A linearization is repeated only if the last evaluation linearized: its factors are
+  // then still those of this point.)
   if (previous_.valid && previous_.frequency_hz == frequency_hz && previous_.scale == excitation_scale_ &&
-      (!J || previous_.has_jacobian) && (!dr_dlambda || previous_.has_derivative) && previous_.w.size() == w.size() &&
-      previous_.w == w) {
+      (!J || previous_.has_jacobian) && (!linearize || previous_.linearized) &&
+      (!dr_dlambda || previous_.has_derivative) && previous_.w.size() == w.size() && previous_.w == w) {
     ++stats_.repeated_evaluations;
     r = previous_.r;
     if (J) *J = previous_.J;
@@ -223,11 +244,11 @@ bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, E
   const Harmonics& hs = harmonics(frequency_hz, dr_dlambda != nullptr);
   {
     log::Stopwatch clock;
-    contacts_.evaluate(w, f_, J ? &blocks_ : nullptr);
+    contacts_.evaluate(w, f_, J || linearize ? &blocks_ : nullptr);
     stats_.contact_seconds += clock.seconds();
   }
   ++stats_.evaluations;
-  if (J) ++stats_.jacobian_evaluations;
+  if (J || linearize) ++stats_.jacobian_evaluations;
   Eigen::VectorXd gf;
   apply(hs.g, f_, gf);
   r = w + gf;
@@ -239,16 +260,19 @@ bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, E
       add_harmonic(-excitation_scale_ * hs.dw_lin[static_cast<std::size_t>(n)], n, *dr_dlambda);
     *dr_dlambda *= kTwoPi;  // d/df = 2 pi d/dw
   }
-  if (J) {
-    jacobian(frequency_hz, blocks_, *J);
+  if (J) jacobian_from(hs.g, blocks_, *J);
+  if (J || linearize) {
     jac_g_ = hs.g;
     jac_blocks_ = blocks_;
     jac_valid_ = true;
   }
-  const bool ok = r.allFinite() && (!J || J->allFinite()) && (!dr_dlambda || dr_dlambda->allFinite());
+  bool ok = r.allFinite() && (!J || J->allFinite()) && (!dr_dlambda || dr_dlambda->allFinite());
+  if (linearize)
+    for (const auto& b : blocks_) ok = ok && b.allFinite();
   if (ok && (!J || static_cast<double>(J->size()) <= kCopyLimit)) {
     previous_.valid = true;
     previous_.has_jacobian = J != nullptr;
+    previous_.linearized = J != nullptr || linearize;
     previous_.has_derivative = dr_dlambda != nullptr;
     previous_.frequency_hz = frequency_hz;
     previous_.scale = excitation_scale_;
@@ -270,11 +294,10 @@ void ReducedEquations::apply_jacobian(const Eigen::VectorXd& z, Eigen::VectorXd&
 }
 
 bool ReducedEquations::gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op,
-                             const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d,
-                             int& iterations) const {
+                             const Eigen::VectorXd& b, Eigen::VectorXd& d, int& iterations) const {
   // Right-preconditioned GMRES, M^-1 = lu_ (an earlier augmented matrix), classical
   // Gram-Schmidt applied twice, Givens rotations on the Hessenberg matrix.
-  const Eigen::Index m = A.rows();
+  const Eigen::Index m = b.size();
   const int kmax = solver_.krylov_max_iterations;
   const double beta = b.norm();
   iterations = 0;
@@ -322,7 +345,9 @@ bool ReducedEquations::gmres(const std::function<void(const Eigen::VectorXd&, Ei
   const Eigen::VectorXd y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
   d.noalias() = Z.leftCols(k) * y;
   // The true residual decides (round-off in the recurrence, a stagnating Krylov space).
-  return d.allFinite() && (A * d - b).norm() <= solver_.krylov_tolerance * beta;
+  if (!d.allFinite()) return false;
+  op(d, w);
+  return (w - b).norm() <= solver_.krylov_tolerance * beta;
 }
 
 bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) {
@@ -353,9 +378,9 @@ bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::Ve
     if (structured) ++stats_.krylov_structured;
     int iterations = 0;
     if (structured)
-      ok = gmres(structured_op, A, b, d, iterations);
+      ok = gmres(structured_op, b, d, iterations);
     else
-      ok = gmres(dense_op, A, b, d, iterations);
+      ok = gmres(dense_op, b, d, iterations);
     stats_.krylov_iterations += iterations;
     if (ok) {
       ++stats_.krylov_solves;
@@ -368,6 +393,52 @@ bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::Ve
     lu_.compute(A);
     ++stats_.dense_factorizations;
     lu_valid_ = krylov;
+    refactor_ = false;
+    d = lu_.solve(b);
+    ok = d.allFinite();
+  }
+  stats_.solve_seconds += clock.seconds();
+  return ok;
+}
+
+bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, const Eigen::VectorXd& b,
+                                      Eigen::VectorXd& d) {
+  SHROUDSIM_CHECK(jac_valid_, "ReducedEquations::solve_bordered before a linearization");
+  log::Stopwatch clock;
+  const int n = size();
+  // y = A z with the factors of the linearization: (I + G D) per pair and harmonic.
+  Eigen::VectorXd xz(n), jz;
+  auto op = [&](const Eigen::VectorXd& z, Eigen::VectorXd& y) {
+    xz = z.head(n).cwiseProduct(A.x_scale);
+    apply_jacobian(xz, jz);
+    y.resize(n + 1);
+    y.head(n) = jz.cwiseQuotient(A.r_scale) + A.column * z[n];
+    y[n] = A.row.dot(z);
+  };
+  bool ok = false;
+  if (lu_valid_ && !refactor_ && lu_.rows() == n + 1) {
+    int iterations = 0;
+    ok = gmres(op, b, d, iterations);
+    ++stats_.krylov_structured;
+    stats_.krylov_iterations += iterations;
+    if (ok) {
+      ++stats_.krylov_solves;
+      refactor_ = iterations > solver_.refactor_after;
+    } else {
+      ++stats_.krylov_failures;
+    }
+  }
+  if (!ok) {
+    // New preconditioner: the dense bordered matrix at this linearization, factorized.
+    Eigen::MatrixXd J;
+    jacobian_from(jac_g_, jac_blocks_, J);
+    Eigen::MatrixXd Ad(n + 1, n + 1);
+    Ad.topLeftCorner(n, n).noalias() = A.r_scale.cwiseInverse().asDiagonal() * J * A.x_scale.asDiagonal();
+    Ad.col(n).head(n) = A.column;
+    Ad.row(n) = A.row.transpose();
+    lu_.compute(Ad);
+    ++stats_.dense_factorizations;
+    lu_valid_ = true;
     refactor_ = false;
     d = lu_.solve(b);
     ok = d.allFinite();

@@ -90,6 +90,15 @@ class ReducedEquations : public continuation::ParametricResidual {
   /// dr/df [m/Hz] = 2 pi (dG/dw F - s dW_lin/dw), exact from the linear part.
   bool has_lambda_derivative() const override { return true; }
   bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override;
+  /// Matrix-free when the Krylov solver is used (krylov, or automatic from krylov_min_size):
+  /// the continuation then never receives the dense J.
+  bool matrix_free() const override;
+  bool linearize(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r,
+                 Eigen::VectorXd* dr_dlambda) override;
+  /// GMRES with the structured product, preconditioned by the LU factors of the dense
+  /// bordered matrix of an earlier linearization (formed and factorized only when GMRES
+  /// needed more than refactor_after iterations or failed).
+  bool solve_bordered(const continuation::BorderedMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override;
 
   void set_linear_solver(const LinearSolverOptions& options) { solver_ = options; lu_valid_ = false; }
   const LinearSolverOptions& linear_solver() const { return solver_; }
@@ -99,6 +108,9 @@ class ReducedEquations : public continuation::ParametricResidual {
   Eigen::MatrixXd dense_jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks) const;
   /// Forms J = I + G(f) D from given per-pair blocks D_p (the structured product).
   void jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks, Eigen::MatrixXd& J);
+  /// The same from the complex G_n of every harmonic.
+  void jacobian_from(const std::vector<Eigen::MatrixXcd>& g_n, const std::vector<Eigen::MatrixXd>& blocks,
+                     Eigen::MatrixXd& J);
 
   /// W_lin(w) in the evaluator layout (the contact motion without contact forces).
   Eigen::VectorXd linear_motion(double frequency_hz) const;
@@ -143,8 +155,11 @@ class ReducedEquations : public continuation::ParametricResidual {
   /// out = sum_n M_n v_n (M = g or dg of h): a block-diagonal-over-harmonics product.
   void apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
   /// GMRES on A d = b with the product `op` (the action of A) and M^-1 = lu_.
-  bool gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op, const Eigen::MatrixXd& A,
-             const Eigen::VectorXd& b, Eigen::VectorXd& d, int& iterations) const;
+  /// The solution is accepted if its true residual with `op` is below krylov_tolerance.
+  bool gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op, const Eigen::VectorXd& b,
+             Eigen::VectorXd& d, int& iterations) const;
+  bool evaluate_impl(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r, Eigen::MatrixXd* J,
+                     Eigen::VectorXd* dr_dlambda, bool linearize);
   /// y = (I + G D) z with the G_n and D_p of the last Jacobian evaluation: O(n b + c^2 H).
   void apply_jacobian(const Eigen::VectorXd& z, Eigen::VectorXd& y) const;
 
@@ -159,7 +174,7 @@ class ReducedEquations : public continuation::ParametricResidual {
   SolverStatistics stats_;
   // The previous evaluation, for repeats at the same point.
   struct Previous {
-    bool valid = false, has_jacobian = false, has_derivative = false;
+    bool valid = false, has_jacobian = false, has_derivative = false, linearized = false;
     double frequency_hz = 0.0, scale = 0.0;
     Eigen::VectorXd w, r, dl;
     Eigen::MatrixXd J;

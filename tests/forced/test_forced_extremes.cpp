@@ -112,7 +112,9 @@ TEST_P(Extremes, ConvergeToTheLimitOrStopCleanly) {
     stuck_peak = std::max(stuck_peak, stuck.amplitude);
   }
   EXPECT_LT(worst_energy, kEnergyTol);
-  if (e.expect == Expect::bounded) EXPECT_LE(peak, kBoundSlack * std::max(free_peak, stuck_peak));
+  if (e.expect == Expect::bounded) {
+    EXPECT_LE(peak, kBoundSlack * std::max(free_peak, stuck_peak));
+  }
 }
 
 constexpr auto full3d = contact::Model::full3d;

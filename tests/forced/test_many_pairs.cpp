@@ -286,7 +286,9 @@ TEST(ManyPairsSector, ExactFrequencyDerivativeOfTheModalReceptanceMatchesCentral
       continue;
     }
     EXPECT_LE((dg - dg_fd).norm(), 1e-6 * dg.norm()) << "n " << n;
-    if (n == 1) EXPECT_LE((dw - dw_fd).norm(), 1e-6 * dw.norm());
+    if (n == 1) {
+      EXPECT_LE((dw - dw_fd).norm(), 1e-6 * dw.norm());
+    }
   }
 }
 
