@@ -481,6 +481,7 @@ int cmd_frf(Context& ctx) {
                  {"krylov_solves", st.krylov_solves},
                  {"krylov_iterations", st.krylov_iterations},
                  {"krylov_failures", st.krylov_failures},
+                 {"double_solves", st.double_solves},
                  {"contact_seconds", st.contact_seconds},
                  {"receptance_seconds", st.receptance_seconds},
                  {"jacobian_seconds", st.jacobian_seconds},

@@ -294,9 +294,10 @@ void ReducedEquations::apply_jacobian(const Eigen::VectorXd& z, Eigen::VectorXd&
 }
 
 bool ReducedEquations::gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op,
+                             const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& precondition,
                              const Eigen::VectorXd& b, Eigen::VectorXd& d, int& iterations) const {
-  // Right-preconditioned GMRES, M^-1 = lu_ (an earlier augmented matrix), classical
-  // Gram-Schmidt applied twice, Givens rotations on the Hessenberg matrix.
+  // Right-preconditioned GMRES (M^-1: the LU factors of an earlier augmented matrix),
+  // classical Gram-Schmidt applied twice, Givens rotations on the Hessenberg matrix.
   const Eigen::Index m = b.size();
   const int kmax = solver_.krylov_max_iterations;
   const double beta = b.norm();
@@ -306,12 +307,13 @@ bool ReducedEquations::gmres(const std::function<void(const Eigen::VectorXd&, Ei
     return true;
   }
   Eigen::MatrixXd V(m, kmax + 1), Z(m, kmax), H = Eigen::MatrixXd::Zero(kmax + 1, kmax);
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(kmax + 1), cs(kmax), sn(kmax), w(m), hcol(kmax + 1);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(kmax + 1), cs(kmax), sn(kmax), w(m), hcol(kmax + 1), z(m);
   V.col(0) = b / beta;
   g[0] = beta;
   int k = 0;
   for (; k < kmax; ++k) {
-    Z.col(k) = lu_.solve(V.col(k));
+    precondition(V.col(k), z);
+    Z.col(k) = z;
     op(Z.col(k), w);
     auto basis = V.leftCols(k + 1);
     hcol.head(k + 1).noalias() = basis.transpose() * w;
@@ -377,10 +379,11 @@ bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::Ve
     }
     if (structured) ++stats_.krylov_structured;
     int iterations = 0;
+    auto precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& z) { z = lu_.solve(v); };
     if (structured)
-      ok = gmres(structured_op, b, d, iterations);
+      ok = gmres(structured_op, precondition, b, d, iterations);
     else
-      ok = gmres(dense_op, b, d, iterations);
+      ok = gmres(dense_op, precondition, b, d, iterations);
     stats_.krylov_iterations += iterations;
     if (ok) {
       ++stats_.krylov_solves;
@@ -415,10 +418,16 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     y.head(n) = jz.cwiseQuotient(A.r_scale) + A.column * z[n];
     y[n] = A.row.dot(z);
   };
+  // The preconditioner in single precision: half the memory traffic of the triangular
+  // solves and twice the vector width of the factorization; GMRES and its true-residual
+  // check stay in double, so only the iteration count can suffer.
+  auto precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& z) {
+    z = luf_.solve(v.cast<float>()).cast<double>();
+  };
   bool ok = false;
-  if (lu_valid_ && !refactor_ && lu_.rows() == n + 1) {
+  if (luf_valid_ && !refactor_ && luf_.rows() == n + 1) {
     int iterations = 0;
-    ok = gmres(op, b, d, iterations);
+    ok = gmres(op, precondition, b, d, iterations);
     ++stats_.krylov_structured;
     stats_.krylov_iterations += iterations;
     if (ok) {
@@ -436,12 +445,25 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     Ad.topLeftCorner(n, n).noalias() = A.r_scale.cwiseInverse().asDiagonal() * J * A.x_scale.asDiagonal();
     Ad.col(n).head(n) = A.column;
     Ad.row(n) = A.row.transpose();
-    lu_.compute(Ad);
+    luf_.compute(Ad.cast<float>());
     ++stats_.dense_factorizations;
-    lu_valid_ = true;
+    luf_valid_ = true;
     refactor_ = false;
-    d = lu_.solve(b);
-    ok = d.allFinite();
+    // With the factors of this very matrix GMRES needs a few iterations (single precision
+    // against double); if even that fails (A too ill-conditioned for single precision), a
+    // direct solve in double answers.
+    int iterations = 0;
+    ok = gmres(op, precondition, b, d, iterations);
+    stats_.krylov_iterations += iterations;
+    if (ok) {
+      ++stats_.krylov_solves;
+    } else {
+      ++stats_.krylov_failures;
+      ++stats_.double_solves;
+      const Eigen::PartialPivLU<Eigen::MatrixXd> lu(Ad);
+      d = lu.solve(b);
+      ok = d.allFinite();
+    }
   }
   stats_.solve_seconds += clock.seconds();
   return ok;
@@ -503,6 +525,17 @@ class ExcitationHomotopy : public continuation::ParametricResidual {
   }
   bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override {
     return eq_.solve_augmented(A, b, d);
+  }
+  // dR/dW is the equations' own J: their matrix-free solves serve the homotopy too.
+  bool matrix_free() const override { return eq_.matrix_free(); }
+  bool linearize(const Eigen::VectorXd& w, double s, Eigen::VectorXd& r, Eigen::VectorXd* dl) override {
+    eq_.set_excitation_scale(s);
+    const bool ok = eq_.linearize(w, frequency_hz_, r, nullptr);
+    if (dl) *dl = -lin_;
+    return ok;
+  }
+  bool solve_bordered(const continuation::BorderedMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override {
+    return eq_.solve_bordered(A, b, d);
   }
   Eigen::VectorXd lin_;
 

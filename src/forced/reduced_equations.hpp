@@ -11,7 +11,7 @@
 // harmonic n of the pair's block D_p, O(n^2) flops instead of the O(n^2 b) of a dense product
 // (b = 3(2H+1) the pair block). The residual never forms the dense G.
 //
-// Linear solves (solve_augmented, the continuation's (n+1) augmented Newton system). G has
+// Linear solves (the continuation's (n+1) bordered Newton system). G has
 // a low-rank modal part but its residual/static flexibility is full rank over the contact
 // DOFs (c = 3 pairs per harmonic), so J - I has full rank and no exact low-rank shortcut
 // exists: the structure exploited is that the Jacobian changes little from one Newton
@@ -22,8 +22,10 @@
 // factors, (I + G D) z = z + G (D z) per pair and per harmonic (O(n b + c^2 H) instead of the
 // O(n^2) of the dense A), once a random probe has shown that A's Jacobian block is that J (the
 // continuation's scaling cancels when x and r share one constant scale; otherwise the dense A
-// is used). The solution is checked by its true residual with the dense A,
-// ||A d - b|| <= krylov_tolerance ||b||.
+// is used). The solution is checked by its true residual, ||A d - b|| <= krylov_tolerance ||b||.
+// When GMRES is the solver the residual is matrix-free for the continuation (linearize,
+// solve_bordered): J is then formed densely only to renew the preconditioner, never per
+// evaluation, and the continuation handles no n x n matrix at all.
 //
 // The residual also gives dr/df (f the frequency in Hz) from the linear part's exact
 // frequency derivative (no extra contact evaluations), and repeats of an evaluation at the
@@ -72,6 +74,7 @@ struct SolverStatistics {
   int krylov_iterations = 0;       ///< their GMRES iterations
   int krylov_failures = 0;         ///< GMRES solves that fell back to a new LU
   int krylov_structured = 0;       ///< GMRES solves with the structured product (I + G D) z
+  int double_solves = 0;           ///< bordered solves where the single-precision factors failed
   double contact_seconds = 0.0;    ///< ContactEvaluator::evaluate
   double receptance_seconds = 0.0; ///< G_n, W_lin,n and their frequency derivatives
   double jacobian_seconds = 0.0;   ///< forming I + G D
@@ -100,7 +103,10 @@ class ReducedEquations : public continuation::ParametricResidual {
   /// needed more than refactor_after iterations or failed).
   bool solve_bordered(const continuation::BorderedMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override;
 
-  void set_linear_solver(const LinearSolverOptions& options) { solver_ = options; lu_valid_ = false; }
+  void set_linear_solver(const LinearSolverOptions& options) {
+    solver_ = options;
+    lu_valid_ = luf_valid_ = false;
+  }
   const LinearSolverOptions& linear_solver() const { return solver_; }
   const SolverStatistics& statistics() const { return stats_; }
   /// The Jacobian I + G(f) D formed densely the plain way (G as a dense n x n real matrix times
@@ -156,7 +162,8 @@ class ReducedEquations : public continuation::ParametricResidual {
   void apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
   /// GMRES on A d = b with the product `op` (the action of A) and M^-1 = lu_.
   /// The solution is accepted if its true residual with `op` is below krylov_tolerance.
-  bool gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op, const Eigen::VectorXd& b,
+  bool gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op,
+             const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& precondition, const Eigen::VectorXd& b,
              Eigen::VectorXd& d, int& iterations) const;
   bool evaluate_impl(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r, Eigen::MatrixXd* J,
                      Eigen::VectorXd* dr_dlambda, bool linearize);
@@ -185,8 +192,9 @@ class ReducedEquations : public continuation::ParametricResidual {
   bool jac_valid_ = false, structured_ok_ = true;
   int probe_failures_ = 0;
   // Lagged preconditioner: LU factors of an earlier augmented matrix.
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
-  bool lu_valid_ = false, refactor_ = false;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;   // solve_augmented
+  Eigen::PartialPivLU<Eigen::MatrixXf> luf_;  // solve_bordered: single precision
+  bool lu_valid_ = false, luf_valid_ = false, refactor_ = false;
 };
 
 }  // namespace shroudsim::forced
