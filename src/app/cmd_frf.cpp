@@ -388,6 +388,7 @@ int cmd_frf(Context& ctx) {
       branch.rejected_steps += second.rejected_steps;
       branch.rejected_turns += second.rejected_turns;
       branch.kinks_crossed += second.kinks_crossed;
+      branch.reflections_crossed += second.reflections_crossed;
       branch.residual_evaluations += second.residual_evaluations;
       if (second.status == continuation::BranchStatus::kReachedEnd) {
         branch.status = continuation::BranchStatus::kReachedEnd;
@@ -464,6 +465,7 @@ int cmd_frf(Context& ctx) {
   j["rejected_steps"] = branch.rejected_steps;
   j["rejected_turns"] = branch.rejected_turns;
   j["kinks_crossed"] = branch.kinks_crossed;
+  j["reflections_crossed"] = branch.reflections_crossed;
   j["residual_evaluations"] = branch.residual_evaluations;
   j["unknowns"] = equations.size();
   j["contact_pairs"] = evaluator.n_pairs();

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -147,6 +148,14 @@ bool tangent_at(Scaled& s, const Eigen::VectorXd& y, const Eigen::VectorXd& row,
   if (t.dot(orient) < 0) t = -t;
   return true;
 }
+
+// Reflection check after a turning point (see TurnWatch in trace): from the
+// kReflectionPoints-th to the kReflectionWindow-th point after the turn, a branch closer to
+// the stretch before the turn (over twice the arclength travelled since the turn) than
+// kReflectionRatio times that arclength is taken for a reflection.
+constexpr int kReflectionPoints = 4;
+constexpr int kReflectionWindow = 16;  // points after the turn that are checked
+constexpr double kReflectionRatio = 0.25;
 
 /// Newton on the augmented system from y (in place). Returns iterations, or -1.
 int corrector(Scaled& s, Eigen::VectorXd& y, const Eigen::VectorXd& t, const Eigen::VectorXd& y_pred,
@@ -296,6 +305,16 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
   const double cos_max_turn = std::cos(o.max_turn_deg * std::numbers::pi / 180.0);
   bool retracing = false, kink_tried = false;
   int retraced_points = 0;
+  // After each turning point: does the branch come back along the stretch it traced before
+  // the turn (a twin of it, a sample away)? A sampled friction law can reflect the branch at
+  // a corner onto such a twin, which then leads all the way back through the start. A true
+  // fold leaves at a distance of the order of the arclength travelled since the turn.
+  struct TurnWatch {
+    bool active = false;
+    std::size_t first = 0;  // index of the first point after the turn
+    double arc = 0.0;       // arclength travelled since the turn
+    int points = 0;
+  } watch;
   std::vector<Eigen::VectorXd> tangents = {t};  // tangent of each accepted point, for backtracking
 
   while (static_cast<int>(branch.points.size()) < o.max_points) {
@@ -355,6 +374,7 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
       }
       ++branch.turning_points;
       retracing = false;
+      watch = {true, branch.points.size(), 0.0, 0};
     }
     // Steep branch: the x part of the tangent jumps.
     const double tx_old = t.head(n).norm(), tx_new = t_new.head(n).norm();
@@ -387,6 +407,47 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
       return branch;
     }
     accept(y, t, it, used_step, rnorm);
+    if (watch.active) {
+      watch.arc += used_step;
+      if (++watch.points >= kReflectionPoints) {
+        if (watch.points >= kReflectionWindow) watch.active = false;
+        // Nearest point of the stretch before the turn that a reflection would retrace: back
+        // from the turn over twice the arclength travelled since.
+        double nearest = std::numeric_limits<double>::infinity(), back = 0.0;
+        for (std::size_t j = watch.first; j-- > 0;) {
+          nearest = std::min(nearest, (s.to_scaled(branch.points[j].x, branch.points[j].lambda) - y).norm());
+          back += branch.points[j].step;  // arclength from point j - 1 to the turn
+          if (back > 2.0 * watch.arc) break;
+        }
+        if (nearest < kReflectionRatio * watch.arc && watch.first >= 1) {
+          // Back to the last point before the turn, and over the corner from there (once).
+          watch.active = false;
+          const std::size_t k = watch.first - 1;
+          const Eigen::VectorXd y0 = s.to_scaled(branch.points[k].x, branch.points[k].lambda), t0 = tangents[k];
+          Eigen::VectorXd yk, tk;
+          int itk = 0;
+          double rk = 0.0;
+          // Only a crossing that goes on past the turn in lambda counts (the other side of a
+          // narrow true fold is a solution too, but not one beyond it).
+          const double ahead = t0[n] > 0 ? 1.0 : -1.0;
+          const double turn_lambda = ahead * std::max(ahead * branch.points[k].lambda, ahead * branch.points[k + 1].lambda);
+          if (cross_kink(s, y0, t0, kink_step, o, yk, tk, itk, rk) && ahead * (s.lambda_of(yk) - turn_lambda) > 0 &&
+              ahead * tk[n] > 0) {
+            branch.points.resize(k + 1);
+            tangents.resize(k + 1);
+            --branch.turning_points;
+            ++branch.reflections_crossed;
+            branch.newton_iterations += itk;
+            step = std::max((yk - y0).norm(), min_step);
+            y = yk;
+            t = tk;
+            tangents.push_back(t);
+            accept(y, t, itk, step, rk);
+            continue;
+          }
+        }
+      }
+    }
     // A retrace walks at the small step until it passes the turn (or has walked ten times the
     // dropped stretch, should the turn have been spurious).
     if (retracing && ++retraced_points > 10 * (o.turning_backtrack + 1)) retracing = false;

@@ -118,6 +118,7 @@ struct Branch {
   int rejected_steps = 0;           ///< corrector failures that shrank the step
   int rejected_turns = 0;           ///< of those, steps whose tangent turned too far (branch jumps)
   int kinks_crossed = 0;            ///< corners of a nonsmooth branch passed along the other piece
+  int reflections_crossed = 0;      ///< "turning points" that were reflections at a corner, crossed
   int residual_evaluations = 0;
 };
 

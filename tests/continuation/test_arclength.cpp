@@ -54,6 +54,7 @@ TEST(Arclength, TracesBothFoldsOfTheDuffingResponse) {
   const Branch b = trace(duffing, Eigen::VectorXd::Zero(2), o);
   ASSERT_EQ(b.status, BranchStatus::kReachedEnd) << b.message;
   EXPECT_EQ(b.turning_points, 2);
+  EXPECT_EQ(b.reflections_crossed, 0);  // true folds are not taken for reflections
   EXPECT_DOUBLE_EQ(b.points.back().lambda, 1.5);
   // Newton converged to 1e-10 on residuals of size ~f; the closed form is the same equation
   // squared, so its relative error is of the order tolerance * x_scale / f.
@@ -94,6 +95,7 @@ TEST(Arclength, PassesATurningPointAndReportsLeavingTheRange) {
   const Branch b = trace(circle, Eigen::VectorXd::Constant(1, 0.9), o);
   EXPECT_EQ(b.status, BranchStatus::kLeftRange) << b.message;
   EXPECT_EQ(b.turning_points, 1);
+  EXPECT_EQ(b.reflections_crossed, 0);
   EXPECT_NEAR(b.points.front().x[0], 1.0, 1e-8);
   EXPECT_NEAR(b.points.back().x[0], -1.0, 1e-6);
   for (const auto& p : b.points) EXPECT_NEAR(p.x[0] * p.x[0] + p.lambda * p.lambda, 1.0, 1e-7);
@@ -105,6 +107,41 @@ TEST(Arclength, PassesATurningPointAndReportsLeavingTheRange) {
     largest = std::max(largest, b.points[i].step);
   }
   EXPECT_TRUE(retraced);
+}
+
+/// x^2 = eps^2 (1 - lambda): a hairpin fold at lambda = 1 whose two sides are 2 eps
+/// sqrt(1 - lambda) apart, closer than a quarter of the arclength from the fold (the
+/// reflection test's threshold) once 1 - lambda > (8 eps)^2: it is taken for a possible
+/// reflection, but nothing lies beyond lambda = 1, so the branch must come back unchanged.
+class Hairpin : public ParametricResidual {
+ public:
+  explicit Hairpin(double eps) : eps_(eps) {}
+  int size() const override { return 1; }
+  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd*) override {
+    r = Eigen::VectorXd::Constant(1, x[0] * x[0] - eps_ * eps_ * (1.0 - l));
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, 2 * x[0]);
+    return true;
+  }
+
+ private:
+  double eps_;
+};
+
+TEST(Arclength, ANarrowTrueFoldIsKeptWhenNothingLiesBeyondIt) {
+  constexpr double kEps = 0.01;
+  Hairpin hairpin(kEps);
+  ArclengthOptions o;
+  o.lambda_start = 0.0;
+  o.lambda_end = 2.0;
+  // x_scale 1: in scaled units the hairpin is narrow (eps = 0.01).
+  o.initial_step = 0.05;
+  o.tolerance = 1e-12;
+  const Branch b = trace(hairpin, Eigen::VectorXd::Constant(1, kEps), o);
+  EXPECT_EQ(b.status, BranchStatus::kLeftRange) << b.message;
+  EXPECT_EQ(b.turning_points, 1);
+  EXPECT_EQ(b.reflections_crossed, 0);
+  EXPECT_NEAR(b.points.back().x[0], -kEps, 1e-9);
+  for (const auto& p : b.points) EXPECT_NEAR(p.x[0] * p.x[0], kEps * kEps * (1.0 - p.lambda), 1e-12) << p.lambda;
 }
 
 /// x^2 + 1 = 0 has no real solution.
