@@ -427,12 +427,17 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
   bool ok = false;
   if (luf_valid_ && !refactor_ && luf_.rows() == n + 1) {
     int iterations = 0;
+    log::Stopwatch gmres_clock;
     ok = gmres(op, precondition, b, d, iterations);
+    krylov_seconds_since_factor_ += gmres_clock.seconds();
     ++stats_.krylov_structured;
     stats_.krylov_iterations += iterations;
     if (ok) {
       ++stats_.krylov_solves;
-      refactor_ = iterations > solver_.refactor_after;
+      // Renew the factors when the lagged ones have become poor (many iterations) and the
+      // iterations since the last factorization have cost more than it did: for large n a
+      // factorization is worth hundreds of iterations.
+      refactor_ = iterations > solver_.refactor_after && krylov_seconds_since_factor_ > factor_seconds_;
     } else {
       ++stats_.krylov_failures;
     }
@@ -445,7 +450,10 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     Ad.topLeftCorner(n, n).noalias() = A.r_scale.cwiseInverse().asDiagonal() * J * A.x_scale.asDiagonal();
     Ad.col(n).head(n) = A.column;
     Ad.row(n) = A.row.transpose();
+    log::Stopwatch factor_clock;
     luf_.compute(Ad.cast<float>());
+    factor_seconds_ = factor_clock.seconds();
+    krylov_seconds_since_factor_ = 0.0;
     ++stats_.dense_factorizations;
     luf_valid_ = true;
     refactor_ = false;

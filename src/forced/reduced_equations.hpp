@@ -61,6 +61,8 @@ struct LinearSolverOptions {
   int krylov_min_size = 250;       ///< (n + 1) below which automatic uses the dense LU
   int krylov_max_iterations = 40;  ///< GMRES iterations before falling back to a new LU
   int refactor_after = 15;         ///< GMRES iterations above which the next solve refactors
+                                   ///< (matrix-free solves: once GMRES has also cost more
+                                   ///< time than the last factorization)
   double krylov_tolerance = 1e-11; ///< relative true residual ||A d - b|| / ||b||
 };
 
@@ -195,6 +197,8 @@ class ReducedEquations : public continuation::ParametricResidual {
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;   // solve_augmented
   Eigen::PartialPivLU<Eigen::MatrixXf> luf_;  // solve_bordered: single precision
   bool lu_valid_ = false, luf_valid_ = false, refactor_ = false;
+  double factor_seconds_ = 0.0;               // the last single-precision factorization
+  double krylov_seconds_since_factor_ = 0.0;  // GMRES time since then
 };
 
 }  // namespace shroudsim::forced
