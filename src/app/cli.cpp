@@ -109,7 +109,7 @@ int run_cli(int argc, char** argv) {
   for (std::size_t i = 0; i < subs.size(); ++i) {
     CLI::App* sub = app.add_subcommand(subs[i].name, subs[i].help);
     add_common(sub, options[i]);
-    if (subs[i].name == "study")
+    if (std::string_view(subs[i].name) == "study")
       sub->add_flag("--convergence", options[i].convergence,
                     "vary every accuracy knob (mesh, modes, residual flexibility, H, N, update, model, Jacobian) "
                     "around the case against its finest value -> trade.csv, trade.png");
