@@ -58,7 +58,7 @@ struct PointResult {
 struct LinearSolverOptions {
   enum class Kind { dense, krylov, automatic };
   Kind kind = Kind::automatic;     ///< automatic: krylov from krylov_min_size unknowns on
-  int krylov_min_size = 120;       ///< (n + 1) below which automatic uses the dense LU
+  int krylov_min_size = 250;       ///< (n + 1) below which automatic uses the dense LU
   int krylov_max_iterations = 40;  ///< GMRES iterations before falling back to a new LU
   int refactor_after = 15;         ///< GMRES iterations above which the next solve refactors
                                    ///< (matrix-free solves: once GMRES has also cost more
