@@ -84,7 +84,8 @@ int cmd_contact(Context& ctx) {
                                                "\" violates: one of \"exact_linear\", \"radial_return\"");
   const auto method = hbm::parse_jacobian(c.hbm.jacobian);
   if (!method)
-    refuse(c, "hbm.jacobian", "= \"" + c.hbm.jacobian + "\" violates: one of \"analytic\", \"finite_difference\"");
+    refuse(c, "hbm.jacobian", "= \"" + c.hbm.jacobian +
+                                  "\" violates: one of \"analytic\", \"finite_difference\", \"finite_difference_full\"");
   if (c.hbm.harmonics_auto || c.hbm.time_samples_auto)
     refuse(c, "hbm.harmonics", "= \"auto\" violates: explicit harmonics and time_samples for `shroudsim contact`");
   const int h = c.hbm.harmonics;

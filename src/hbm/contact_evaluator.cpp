@@ -18,11 +18,17 @@ namespace shroudsim::hbm {
 std::optional<JacobianMethod> parse_jacobian(std::string_view text) {
   if (text == "analytic") return JacobianMethod::analytic;
   if (text == "finite_difference") return JacobianMethod::finite_difference;
+  if (text == "finite_difference_full") return JacobianMethod::finite_difference_full;
   return std::nullopt;
 }
 
 std::string to_string(JacobianMethod method) {
-  return method == JacobianMethod::analytic ? "analytic" : "finite_difference";
+  switch (method) {
+    case JacobianMethod::analytic: return "analytic";
+    case JacobianMethod::finite_difference: return "finite_difference";
+    case JacobianMethod::finite_difference_full: return "finite_difference_full";
+  }
+  return "unknown";
 }
 
 bool ContactEvaluatorOptions::validate(std::vector<std::string>* errors) const {
@@ -244,6 +250,26 @@ EvaluationStatus ContactEvaluator::evaluate(const Eigen::VectorXd& w, Eigen::Vec
   if (jacobian) jacobian->resize(pairs_.size());
   const int s = layout_.size();
   const int np = n_pairs();
+  if (jacobian && method == JacobianMethod::finite_difference_full) {
+    // Column c of dF/dW from two evaluations of all pairs with W_c moved by -+h; only the
+    // block of c's own pair comes out nonzero (each pair's force depends on its own W).
+    const EvaluationStatus status = evaluate(w, f, nullptr, method);
+    Eigen::VectorXd wp = w, fp, fm;
+    for (int p = 0; p < np; ++p) (*jacobian)[p].resize(s, s);
+    for (int c = 0; c < size(); ++c) {
+      const int p = c / s, local = c % s;
+      const double h = fd_step(p, w.data() + static_cast<std::ptrdiff_t>(p) * s, local);
+      wp[c] = w[c] + h;
+      const double hp = wp[c] - w[c];
+      evaluate(wp, fp, nullptr, method);
+      wp[c] = w[c] - h;
+      const double hm = w[c] - wp[c];
+      evaluate(wp, fm, nullptr, method);
+      wp[c] = w[c];
+      (*jacobian)[p].col(local) = (fp - fm).segment(static_cast<Eigen::Index>(p) * s, s) / (hp + hm);
+    }
+    return status;
+  }
   std::vector<contact::PeriodicStatus> st(np);
   std::exception_ptr error;
   auto one = [&](int p, Workspace& ws) {
@@ -293,7 +319,7 @@ void ContactEvaluator::evaluate_pair(int pair, const Eigen::VectorXd& w_pair, Pa
   if (with_jacobian) {
     d.status = options_.jacobian == JacobianMethod::analytic
                    ? analytic(pair, w_pair.data(), d.force.data(), d.jacobian, ws)
-                   : finite_difference(pair, w_pair.data(), d.force.data(), d.jacobian, ws);
+                   : finite_difference(pair, w_pair.data(), d.force.data(), d.jacobian, ws);  // (either FD)
   } else {
     d.jacobian.resize(0, 0);
     d.status = residual(pair, w_pair.data(), d.force.data(), ws);

@@ -33,9 +33,15 @@ namespace shroudsim::hbm {
 
 enum class JacobianMethod {
   analytic,           ///< differentiated time recursion, Fourier-projected (the default)
-  finite_difference   ///< central differences of the same discrete map (2 P residuals per pair)
+  finite_difference,  ///< central differences of the same discrete map (2 P residuals per pair)
+  /// Central differences of the whole contact-force vector: every unknown perturbed in turn
+  /// and all pairs evaluated each time (2 n evaluations of every pair per Jacobian), the
+  /// block-diagonal structure not used. The finite-difference Jacobian as commonly written
+  /// (the paper's Example 4 compares against it); for comparison only, it is slow.
+  finite_difference_full
 };
-std::optional<JacobianMethod> parse_jacobian(std::string_view text);  ///< "analytic", "finite_difference"
+/// "analytic", "finite_difference", "finite_difference_full"
+std::optional<JacobianMethod> parse_jacobian(std::string_view text);
 std::string to_string(JacobianMethod method);
 
 struct ContactEvaluatorOptions {

@@ -528,7 +528,7 @@ void read_all(Reader& r, Case& c) {
         r.violates(key, n, "time_samples >= 2*harmonics+1 (= " + std::to_string(2 * h.harmonics + 1) + ")");
     }
   }
-  h.jacobian = r.string("hbm.jacobian", {"analytic", "finite_difference"});
+  h.jacobian = r.string("hbm.jacobian", {"analytic", "finite_difference", "finite_difference_full"});
   h.tolerance = r.number("hbm.tolerance", [](double v) -> std::optional<std::string> {
     return v > 0 && v < 1 ? std::nullopt : std::optional<std::string>("0 < tolerance < 1");
   });

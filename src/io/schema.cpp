@@ -84,7 +84,7 @@ const std::vector<KeySpec>& case_schema() {
 
       {"hbm.harmonics", "5", "1 <= H <= 200, or \"auto\"", "H: harmonics 0..H"},
       {"hbm.time_samples", "512", "N >= 2H+1, <= 65536, or \"auto\"", "N: time samples per period"},
-      {"hbm.jacobian", "\"analytic\"", "\"analytic\" | \"finite_difference\"", "Jacobian of the contact forces"},
+      {"hbm.jacobian", "\"analytic\"", "\"analytic\" | \"finite_difference\" | \"finite_difference_full\"", "Jacobian of the contact forces (finite_difference: per pair; _full: the whole force vector, for comparison only)"},
       {"hbm.tolerance", "1e-8", "0 < tol < 1", "Newton tolerance on the scaled residual"},
       {"hbm.auto_tolerance", "0.01", "0 < tol < 1", "\"auto\" H or N: stop when the peak amplitude changes by less (relative)"},
       {"hbm.auto_max_harmonics", "25", "1 <= H <= 200", "\"auto\" harmonics: largest H tried"},

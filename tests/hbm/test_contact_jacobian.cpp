@@ -119,3 +119,38 @@ TEST(ContactEvaluator, PairsAreIndependentAndThreadingChangesNothing) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(JacobianMethods, WholeVectorFiniteDifferenceEqualsThePerPairOne) {
+  // finite_difference_full perturbs every unknown and evaluates all pairs; each pair's force
+  // depends only on its own W, so its blocks are the per-pair differences, evaluated on the
+  // same perturbed states: equal to round-off (the same arithmetic on each pair).
+  shroudsim::contact::PairParameters p;
+  p.tangential_stiffness = 2.0e5;
+  p.normal_stiffness = 5.0e5;
+  p.friction_coefficient = 0.4;
+  p.normal_preload = 3.0;
+  shroudsim::hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = 2;
+  o.n_time_samples = 64;
+  o.measure_plans = false;
+  constexpr int kPairs = 3;
+  ContactEvaluator ev(o, std::vector<shroudsim::contact::PairParameters>(kPairs, p));
+  std::mt19937 rng(20261201);
+  Eigen::VectorXd w(ev.size());
+  for (int s = 0; s < kPairs; ++s)
+    w.segment(s * ev.pair_layout().size(), ev.pair_layout().size()) =
+        shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
+  Eigen::VectorXd f1, f2;
+  std::vector<Eigen::MatrixXd> j1, j2;
+  ev.evaluate(w, f1, &j1, JacobianMethod::finite_difference);
+  ev.evaluate(w, f2, &j2, JacobianMethod::finite_difference_full);
+  EXPECT_EQ(f1, f2);
+  ASSERT_EQ(j2.size(), j1.size());
+  for (int s = 0; s < kPairs; ++s) EXPECT_LE((j1[s] - j2[s]).norm(), 1e-12 * j1[s].norm()) << "pair " << s;
+  EXPECT_EQ(shroudsim::hbm::parse_jacobian("finite_difference_full"), JacobianMethod::finite_difference_full);
+  EXPECT_EQ(shroudsim::hbm::to_string(JacobianMethod::finite_difference_full), "finite_difference_full");
+}
+
+}  // namespace
