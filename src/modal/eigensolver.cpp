@@ -86,16 +86,22 @@ StiffnessFactor StiffnessFactor::conjugate() const {
   return StiffnessFactor(complex_, !conjugated_);
 }
 
+// The StiffnessFactor holding a factor of K itself (not conjugated).
+template <typename Scalar>
+static StiffnessFactor stiffness_factor(std::shared_ptr<const linalg::CholmodFactor<Scalar>> f) {
+  if constexpr (std::is_same_v<Scalar, double>)
+    return StiffnessFactor(std::move(f));
+  else
+    return StiffnessFactor(std::move(f), false);
+}
+
 template <typename Scalar>
 static StiffnessFactor factor_stiffness_impl(const linalg::SparseMatrix<Scalar>& K, linalg::FactorMethod method) {
   auto f = std::make_shared<linalg::CholmodFactor<Scalar>>(method);
   const auto status = f->compute(K);
   if (status != linalg::FactorStatus::Success)
     throw NumericalError("factorization of the stiffness matrix failed: " + linalg::to_string(status));
-  if constexpr (std::is_same_v<Scalar, double>)
-    return StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>>(f));
-  else
-    return StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(f), false);
+  return stiffness_factor<Scalar>(f);
 }
 
 StiffnessFactor factor_stiffness(const SparseMatrixD& K, linalg::FactorMethod method) {
@@ -423,12 +429,7 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
     for (std::size_t j = 0; j < vecs.size(); ++j) phi.col(static_cast<Eigen::Index>(j)) = vecs[j];
     result = finish<S>(km, h, lambda, phi, options, report);
   }
-  if (result.report.ok() && options.shift == 0.0 && !reuse) {
-    if constexpr (kIsComplex<S>)
-      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(factor), false);
-    else
-      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>>(factor));
-  }
+  if (result.report.ok() && options.shift == 0.0 && !reuse) result.stiffness = stiffness_factor<S>(factor);
   return result;
 }
 
@@ -614,12 +615,7 @@ ModalResult solve_block(const linalg::SparsePair<S>& km, int h, const ModalOptio
   const Eigen::VectorXd lambda = (1.0 / nu.array() + options.shift).matrix();
   report.solve_seconds = watch.seconds();
   ModalResult result = finish<S>(km, h, lambda, X, options, report);
-  if (result.report.ok() && options.shift == 0.0 && !reuse) {
-    if constexpr (kIsComplex<S>)
-      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>>(factor), false);
-    else
-      result.stiffness = StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>>(factor));
-  }
+  if (result.report.ok() && options.shift == 0.0 && !reuse) result.stiffness = stiffness_factor<S>(factor);
   return result;
 }
 

@@ -29,15 +29,31 @@ constexpr double kSameResidualTol = 64 * std::numeric_limits<double>::epsilon();
 constexpr double kShareTol = 1e-5;      // error bound met by ...
 constexpr double kShareRequired = 0.8;  // ... at least this share of the states
 
-class JacobianVsFd : public ::testing::TestWithParam<std::tuple<Model, TangentialUpdate, int, int>> {};
-
-TEST_P(JacobianVsFd, MatchesCentralDifferences) {
-  const auto [model, update, h, n] = GetParam();
+// The pair of every test here: sticking, slipping and separating states all occur.
+shroudsim::contact::PairParameters test_pair() {
   shroudsim::contact::PairParameters p;
   p.tangential_stiffness = 2.0e5;
   p.normal_stiffness = 5.0e5;
   p.friction_coefficient = 0.4;
   p.normal_preload = 3.0;
+  return p;
+}
+
+// One seeded random state per pair of ev (all pairs with parameters p).
+Eigen::VectorXd random_states(const ContactEvaluator& ev, const shroudsim::contact::PairParameters& p,
+                              unsigned seed) {
+  std::mt19937 rng(seed);
+  Eigen::VectorXd w(ev.size());
+  const int s = ev.pair_layout().size();
+  for (int k = 0; k < ev.n_pairs(); ++k) w.segment(k * s, s) = shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
+  return w;
+}
+
+class JacobianVsFd : public ::testing::TestWithParam<std::tuple<Model, TangentialUpdate, int, int>> {};
+
+TEST_P(JacobianVsFd, MatchesCentralDifferences) {
+  const auto [model, update, h, n] = GetParam();
+  const shroudsim::contact::PairParameters p = test_pair();
   shroudsim::hbm::ContactEvaluatorOptions o;
   o.n_harmonics = h;
   o.n_time_samples = n;
@@ -46,11 +62,7 @@ TEST_P(JacobianVsFd, MatchesCentralDifferences) {
   o.measure_plans = false;
   constexpr int kStates = 24;
   ContactEvaluator ev(o, std::vector<shroudsim::contact::PairParameters>(kStates, p));
-  std::mt19937 rng(20261122);
-  Eigen::VectorXd w(ev.size());
-  for (int s = 0; s < kStates; ++s)
-    w.segment(s * ev.pair_layout().size(), ev.pair_layout().size()) =
-        shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
+  const Eigen::VectorXd w = random_states(ev, p, 20261122);
   Eigen::VectorXd fa, ff;
   std::vector<Eigen::MatrixXd> ja, jf;
   const auto sa = ev.evaluate(w, fa, &ja, JacobianMethod::analytic);
@@ -126,22 +138,14 @@ TEST(JacobianMethods, WholeVectorFiniteDifferenceEqualsThePerPairOne) {
   // finite_difference_full perturbs every unknown and evaluates all pairs; each pair's force
   // depends only on its own W, so its blocks are the per-pair differences, evaluated on the
   // same perturbed states: equal to round-off (the same arithmetic on each pair).
-  shroudsim::contact::PairParameters p;
-  p.tangential_stiffness = 2.0e5;
-  p.normal_stiffness = 5.0e5;
-  p.friction_coefficient = 0.4;
-  p.normal_preload = 3.0;
+  const shroudsim::contact::PairParameters p = test_pair();
   shroudsim::hbm::ContactEvaluatorOptions o;
   o.n_harmonics = 2;
   o.n_time_samples = 64;
   o.measure_plans = false;
   constexpr int kPairs = 3;
   ContactEvaluator ev(o, std::vector<shroudsim::contact::PairParameters>(kPairs, p));
-  std::mt19937 rng(20261201);
-  Eigen::VectorXd w(ev.size());
-  for (int s = 0; s < kPairs; ++s)
-    w.segment(s * ev.pair_layout().size(), ev.pair_layout().size()) =
-        shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
+  const Eigen::VectorXd w = random_states(ev, p, 20261201);
   Eigen::VectorXd f1, f2;
   std::vector<Eigen::MatrixXd> j1, j2;
   ev.evaluate(w, f1, &j1, JacobianMethod::finite_difference);
