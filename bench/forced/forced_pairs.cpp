@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
               << " contact_s=" << s.contact_seconds << " receptance_s=" << s.receptance_seconds
               << " jacobian_s=" << s.jacobian_seconds << " solve_s=" << s.solve_seconds
               << " factorizations=" << s.dense_factorizations << " krylov_solves=" << s.krylov_solves
-              << " krylov_iterations=" << s.krylov_iterations << " krylov_failures=" << s.krylov_failures << " krylov_structured=" << s.krylov_structured;
+              << " krylov_iterations=" << s.krylov_iterations << " krylov_failures=" << s.krylov_failures;
     // Cost of one contact evaluation of all pairs at the last point (median of 7): residual
     // only, with the analytic Jacobian, with the block finite-difference Jacobian (2 residuals
     // per coefficient of each pair: what hbm.jacobian = "finite_difference" does), and what a

@@ -261,7 +261,7 @@ bool ReducedEquations::evaluate_impl(const Eigen::VectorXd& w, double frequency_
     *dr_dlambda *= kTwoPi;  // d/df = 2 pi d/dw
   }
   if (J) jacobian_from(hs.g, blocks_, *J);
-  if (J || linearize) {
+  if (linearize) {  // the factors solve_bordered() multiplies with
     jac_g_ = hs.g;
     jac_blocks_ = blocks_;
     jac_valid_ = true;
@@ -272,7 +272,7 @@ bool ReducedEquations::evaluate_impl(const Eigen::VectorXd& w, double frequency_
   if (ok && (!J || static_cast<double>(J->size()) <= kCopyLimit)) {
     previous_.valid = true;
     previous_.has_jacobian = J != nullptr;
-    previous_.linearized = J != nullptr || linearize;
+    previous_.linearized = linearize;
     previous_.has_derivative = dr_dlambda != nullptr;
     previous_.frequency_hz = frequency_hz;
     previous_.scale = excitation_scale_;
@@ -353,55 +353,14 @@ bool ReducedEquations::gmres(const std::function<void(const Eigen::VectorXd&, Ei
 }
 
 bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) {
+  // Only below krylov_min_size unknowns (or with the dense solver): larger systems are
+  // matrix-free and go through solve_bordered().
   log::Stopwatch clock;
-  const bool krylov = solver_.kind == LinearSolverOptions::Kind::krylov ||
-                      (solver_.kind == LinearSolverOptions::Kind::automatic && A.rows() >= solver_.krylov_min_size);
-  bool ok = false;
-  if (krylov && lu_valid_ && !refactor_ && lu_.rows() == A.rows()) {
-    const int n = size();
-    auto dense_op = [&](const Eigen::VectorXd& z, Eigen::VectorXd& y) { y.noalias() = A * z; };
-    auto structured_op = [&](const Eigen::VectorXd& z, Eigen::VectorXd& y) {
-      Eigen::VectorXd jz;
-      apply_jacobian(z, jz);
-      y.resize(n + 1);
-      y.head(n) = jz + A.col(n).head(n) * z[n];
-      y[n] = A.row(n).dot(z);
-    };
-    // Is A's Jacobian block the last J? (One dense product with a fixed pseudo-random probe.)
-    bool structured = false;
-    if (structured_ok_ && jac_valid_ && A.rows() == n + 1) {
-      const Eigen::VectorXd probe = Eigen::VectorXd::LinSpaced(n + 1, 1.0, 2.0).array().sin();
-      Eigen::VectorXd ya, ys;
-      dense_op(probe, ya);
-      structured_op(probe, ys);
-      structured = (ya - ys).norm() <= 1e-12 * ya.norm();
-      if (!structured && ++probe_failures_ >= 3) structured_ok_ = false;  // another scaling: stop probing
-    }
-    if (structured) ++stats_.krylov_structured;
-    int iterations = 0;
-    auto precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& z) { z = lu_.solve(v); };
-    if (structured)
-      ok = gmres(structured_op, precondition, b, d, iterations);
-    else
-      ok = gmres(dense_op, precondition, b, d, iterations);
-    stats_.krylov_iterations += iterations;
-    if (ok) {
-      ++stats_.krylov_solves;
-      refactor_ = iterations > solver_.refactor_after;
-    } else {
-      ++stats_.krylov_failures;
-    }
-  }
-  if (!ok) {
-    lu_.compute(A);
-    ++stats_.dense_factorizations;
-    lu_valid_ = krylov;
-    refactor_ = false;
-    d = lu_.solve(b);
-    ok = d.allFinite();
-  }
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(A);
+  ++stats_.dense_factorizations;
+  d = lu.solve(b);
   stats_.solve_seconds += clock.seconds();
-  return ok;
+  return d.allFinite();
 }
 
 bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, const Eigen::VectorXd& b,
@@ -430,7 +389,6 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     log::Stopwatch gmres_clock;
     ok = gmres(op, precondition, b, d, iterations);
     krylov_seconds_since_factor_ += gmres_clock.seconds();
-    ++stats_.krylov_structured;
     stats_.krylov_iterations += iterations;
     if (ok) {
       ++stats_.krylov_solves;

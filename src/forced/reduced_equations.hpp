@@ -15,17 +15,17 @@
 // a low-rank modal part but its residual/static flexibility is full rank over the contact
 // DOFs (c = 3 pairs per harmonic), so J - I has full rank and no exact low-rank shortcut
 // exists: the structure exploited is that the Jacobian changes little from one Newton
-// iteration and continuation step to the next. Above `krylov_min_size` unknowns the system
-// is solved by GMRES (exact products with the dense augmented matrix) right-preconditioned
-// by the LU factors of an earlier augmented matrix; the factors are renewed when GMRES needs
-// many iterations or fails, so the worst case is the dense LU. The GMRES products use the
-// factors, (I + G D) z = z + G (D z) per pair and per harmonic (O(n b + c^2 H) instead of the
-// O(n^2) of the dense A), once a random probe has shown that A's Jacobian block is that J (the
-// continuation's scaling cancels when x and r share one constant scale; otherwise the dense A
-// is used). The solution is checked by its true residual, ||A d - b|| <= krylov_tolerance ||b||.
-// When GMRES is the solver the residual is matrix-free for the continuation (linearize,
-// solve_bordered): J is then formed densely only to renew the preconditioner, never per
-// evaluation, and the continuation handles no n x n matrix at all.
+// iteration and continuation step to the next. Below `krylov_min_size` unknowns the
+// continuation receives the dense J and the augmented system is solved by a dense LU
+// (solve_augmented). From krylov_min_size on the residual is matrix-free for the
+// continuation (linearize, solve_bordered): the bordered system is solved by GMRES whose
+// products use the factors of the linearization, (I + G D) z = z + G (D z) per pair and per
+// harmonic (O(n b + c^2 H) instead of the O(n^2) of a dense product), right-preconditioned by
+// the single-precision LU factors of the dense bordered matrix of an earlier linearization.
+// J is formed densely only to renew those factors (when GMRES failed, or needed many
+// iterations that have cost more than the last factorization), never per evaluation, so the
+// worst case is one dense LU per solve. The solution is checked by its true residual,
+// ||A d - b|| <= krylov_tolerance ||b||, in double precision.
 //
 // The residual also gives dr/df (f the frequency in Hz) from the linear part's exact
 // frequency derivative (no extra contact evaluations), and repeats of an evaluation at the
@@ -54,7 +54,7 @@ struct PointResult {
   int unconverged_pairs = 0;
 };
 
-/// How solve_augmented() solves the augmented Newton systems.
+/// How the augmented Newton systems are solved.
 struct LinearSolverOptions {
   enum class Kind { dense, krylov, automatic };
   Kind kind = Kind::automatic;     ///< automatic: krylov from krylov_min_size unknowns on
@@ -75,12 +75,11 @@ struct SolverStatistics {
   int krylov_solves = 0;           ///< solves done by preconditioned GMRES
   int krylov_iterations = 0;       ///< their GMRES iterations
   int krylov_failures = 0;         ///< GMRES solves that fell back to a new LU
-  int krylov_structured = 0;       ///< GMRES solves with the structured product (I + G D) z
   int double_solves = 0;           ///< bordered solves where the single-precision factors failed
   double contact_seconds = 0.0;    ///< ContactEvaluator::evaluate
   double receptance_seconds = 0.0; ///< G_n, W_lin,n and their frequency derivatives
   double jacobian_seconds = 0.0;   ///< forming I + G D
-  double solve_seconds = 0.0;      ///< solve_augmented
+  double solve_seconds = 0.0;      ///< solve_augmented and solve_bordered
 };
 
 class ReducedEquations : public continuation::ParametricResidual {
@@ -107,7 +106,7 @@ class ReducedEquations : public continuation::ParametricResidual {
 
   void set_linear_solver(const LinearSolverOptions& options) {
     solver_ = options;
-    lu_valid_ = luf_valid_ = false;
+    luf_valid_ = false;
   }
   const LinearSolverOptions& linear_solver() const { return solver_; }
   const SolverStatistics& statistics() const { return stats_; }
@@ -162,7 +161,7 @@ class ReducedEquations : public continuation::ParametricResidual {
   void add_harmonic(const Eigen::VectorXcd& z, int n, Eigen::VectorXd& out) const;
   /// out = sum_n M_n v_n (M = g or dg of h): a block-diagonal-over-harmonics product.
   void apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
-  /// GMRES on A d = b with the product `op` (the action of A) and M^-1 = lu_.
+  /// GMRES on A d = b with the product `op` (the action of A) and the preconditioner M^-1.
   /// The solution is accepted if its true residual with `op` is below krylov_tolerance.
   bool gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op,
              const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& precondition, const Eigen::VectorXd& b,
@@ -191,12 +190,10 @@ class ReducedEquations : public continuation::ParametricResidual {
   // The factors of the last Jacobian evaluation, for products with J without the dense J.
   std::vector<Eigen::MatrixXcd> jac_g_;
   std::vector<Eigen::MatrixXd> jac_blocks_;
-  bool jac_valid_ = false, structured_ok_ = true;
-  int probe_failures_ = 0;
+  bool jac_valid_ = false;
   // Lagged preconditioner: LU factors of an earlier augmented matrix.
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;   // solve_augmented
-  Eigen::PartialPivLU<Eigen::MatrixXf> luf_;  // solve_bordered: single precision
-  bool lu_valid_ = false, luf_valid_ = false, refactor_ = false;
+  Eigen::PartialPivLU<Eigen::MatrixXf> luf_;  // single precision
+  bool luf_valid_ = false, refactor_ = false;
   double factor_seconds_ = 0.0;               // the last single-precision factorization
   double krylov_seconds_since_factor_ = 0.0;  // GMRES time since then
 };

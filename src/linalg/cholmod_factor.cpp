@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 #include "core/error.hpp"
 
@@ -116,36 +117,36 @@ void CholmodFactor<Scalar>::solve(const Scalar* b, Scalar* x) const {
 }
 
 template <typename Scalar>
-void CholmodFactor<Scalar>::solve_forward(const Scalar* b, Scalar* x) const {
-  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_forward without a valid factor");
+void CholmodFactor<Scalar>::half_solve(int first, int second, const Scalar* b, Scalar* x, Eigen::Index ncol,
+                                       const char* name) const {
+  SHROUDSIM_CHECK(status_ == FactorStatus::Success, std::string("CholmodFactor::") + name + " without a valid factor");
   SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
-  impl_->two_step(CHOLMOD_P, CHOLMOD_L, b, x, rows_);
+  if (ncol > 0) impl_->two_step(first, second, b, x, rows_, ncol);
+}
+
+template <typename Scalar>
+void CholmodFactor<Scalar>::solve_forward(const Scalar* b, Scalar* x) const {
+  half_solve(CHOLMOD_P, CHOLMOD_L, b, x, 1, "solve_forward");
 }
 
 template <typename Scalar>
 void CholmodFactor<Scalar>::solve_backward(const Scalar* b, Scalar* x) const {
-  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_backward without a valid factor");
-  SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
-  impl_->two_step(CHOLMOD_Lt, CHOLMOD_Pt, b, x, rows_);
+  half_solve(CHOLMOD_Lt, CHOLMOD_Pt, b, x, 1, "solve_backward");
 }
 
 template <typename Scalar>
 typename CholmodFactor<Scalar>::Matrix CholmodFactor<Scalar>::solve_forward(const Matrix& b) const {
-  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_forward without a valid factor");
-  SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
   SHROUDSIM_CHECK(b.rows() == rows_, "CholmodFactor::solve_forward: right-hand side has the wrong size");
   Matrix x(rows_, b.cols());
-  if (b.cols() > 0) impl_->two_step(CHOLMOD_P, CHOLMOD_L, b.data(), x.data(), rows_, b.cols());
+  half_solve(CHOLMOD_P, CHOLMOD_L, b.data(), x.data(), b.cols(), "solve_forward");
   return x;
 }
 
 template <typename Scalar>
 typename CholmodFactor<Scalar>::Matrix CholmodFactor<Scalar>::solve_backward(const Matrix& b) const {
-  SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve_backward without a valid factor");
-  SHROUDSIM_CHECK(impl_->llt.factor()->is_ll, "CholmodFactor: half solves need an LL^H factor");
   SHROUDSIM_CHECK(b.rows() == rows_, "CholmodFactor::solve_backward: right-hand side has the wrong size");
   Matrix x(rows_, b.cols());
-  if (b.cols() > 0) impl_->two_step(CHOLMOD_Lt, CHOLMOD_Pt, b.data(), x.data(), rows_, b.cols());
+  half_solve(CHOLMOD_Lt, CHOLMOD_Pt, b.data(), x.data(), b.cols(), "solve_backward");
   return x;
 }
 

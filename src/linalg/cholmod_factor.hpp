@@ -70,6 +70,9 @@ class CholmodFactor {
 
  private:
   struct Impl;
+  /// x = the half solve (CHOLMOD systems `first` then `second`) of ncol columns of b, after
+  /// checking the factor; `name` is the calling function's, for the messages.
+  void half_solve(int first, int second, const Scalar* b, Scalar* x, Eigen::Index ncol, const char* name) const;
   std::unique_ptr<Impl> impl_;
   FactorStatus status_ = FactorStatus::Failed;
   Eigen::Index rows_ = 0;
