@@ -1,6 +1,7 @@
 #include "frf/sector.hpp"
 
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -50,19 +51,32 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
   SHROUDSIM_CHECK(forcing_.excitation_node >= 0 && forcing_.response_node >= 0, "excitation and response nodes set");
   std::set<int> needed;
   for (int n = 1; n <= n_harmonics_; ++n) needed.insert(harmonic_index(n));
-  // Static flexibility of the static harmonic (h = 0) and of each dynamic index's residual.
-  auto static_flexibility = [&](int h, const Eigen::MatrixXcd& ct) {
+  // Static flexibility of the static harmonic (h = 0) and of each dynamic index's residual:
+  // C_h K_h^-1 C_h^H, solved for kFlexibilityBlock columns of C_h^H at a time. C_h (k x n) is
+  // sparse (each row touches two nodes); all its k columns as one dense right-hand side
+  // would be n x k complex, 2.6 GB on a 238k-DOF sector with 227 pairs (and CHOLMOD copies
+  // it twice more), where a block of 64 columns is 0.24 GB.
+  constexpr Eigen::Index kFlexibilityBlock = 64;
+  auto static_flexibility = [&](int h, const Eigen::SparseMatrix<Complex>& ct) {
     const modal::StiffnessFactor k = factor(h);
-    const Eigen::MatrixXcd y = k.solve(ct.adjoint());
-    return Eigen::MatrixXcd(ct * y);
+    const Eigen::SparseMatrix<Complex> cth = ct.adjoint();
+    Eigen::MatrixXcd flex(ct.rows(), ct.rows());
+    for (Eigen::Index j0 = 0; j0 < cth.cols(); j0 += kFlexibilityBlock) {
+      const Eigen::Index nb = std::min(kFlexibilityBlock, cth.cols() - j0);
+      const Eigen::MatrixXcd y = k.solve(Eigen::MatrixXcd(cth.middleCols(j0, nb)));
+      flex.middleCols(j0, nb).noalias() = ct * y;
+    }
+    return flex;
   };
+  // C_h T_h (k x n_reduced): the rows of the contact, response and excitation DOFs in the
+  // reduced coordinates of harmonic index h, kept sparse.
   auto projected = [&](int h) {
     const Eigen::SparseMatrix<Complex> c = selection(pairs_, forcing_, sector, h, sector.n_full());
     const Eigen::SparseMatrix<Complex> t = sector.expansion(h);
-    return Eigen::MatrixXcd(Eigen::MatrixXcd(c * t));
+    return Eigen::SparseMatrix<Complex>(c * t);
   };
   {
-    const Eigen::MatrixXcd ct = projected(0);
+    const Eigen::SparseMatrix<Complex> ct = projected(0);
     static_.flex = static_flexibility(0, ct);
   }
   for (int h : needed) {
@@ -71,7 +85,7 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
     const modal::ModalBasis& b = it->second;
     IndexData d;
     d.omega = b.omega;
-    const Eigen::MatrixXcd ct = projected(h);
+    const Eigen::SparseMatrix<Complex> ct = projected(h);
     d.psi = ct * b.phi;
     if (forcing_.residual_flexibility) {
       d.flex = static_flexibility(h, ct);
