@@ -49,17 +49,24 @@ Eigen::VectorXd random_states(const ContactEvaluator& ev, const shroudsim::conta
   return w;
 }
 
+// Evaluator options for H harmonics and N samples; FFTW plans estimated, not measured (the
+// tests time nothing).
+shroudsim::hbm::ContactEvaluatorOptions evaluator_options(int h, int n) {
+  shroudsim::hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = h;
+  o.n_time_samples = n;
+  o.measure_plans = false;
+  return o;
+}
+
 class JacobianVsFd : public ::testing::TestWithParam<std::tuple<Model, TangentialUpdate, int, int>> {};
 
 TEST_P(JacobianVsFd, MatchesCentralDifferences) {
   const auto [model, update, h, n] = GetParam();
   const shroudsim::contact::PairParameters p = test_pair();
-  shroudsim::hbm::ContactEvaluatorOptions o;
-  o.n_harmonics = h;
-  o.n_time_samples = n;
+  shroudsim::hbm::ContactEvaluatorOptions o = evaluator_options(h, n);
   o.law.model = model;
   o.law.update = update;
-  o.measure_plans = false;
   constexpr int kStates = 24;
   ContactEvaluator ev(o, std::vector<shroudsim::contact::PairParameters>(kStates, p));
   const Eigen::VectorXd w = random_states(ev, p, 20261122);
@@ -102,10 +109,7 @@ TEST(ContactEvaluator, PairsAreIndependentAndThreadingChangesNothing) {
   shroudsim::contact::PairParameters p;
   std::vector<shroudsim::contact::PairParameters> pairs(7, p);
   for (int i = 0; i < 7; ++i) pairs[i].normal_preload = 0.1 + 0.2 * i;
-  shroudsim::hbm::ContactEvaluatorOptions o;
-  o.n_harmonics = 3;
-  o.n_time_samples = 64;
-  o.measure_plans = false;
+  shroudsim::hbm::ContactEvaluatorOptions o = evaluator_options(3, 64);
   o.threads = 2;
   ContactEvaluator par(o, pairs);
   o.threads = 1;
@@ -139,10 +143,7 @@ TEST(JacobianMethods, WholeVectorFiniteDifferenceEqualsThePerPairOne) {
   // depends only on its own W, so its blocks are the per-pair differences, evaluated on the
   // same perturbed states: equal to round-off (the same arithmetic on each pair).
   const shroudsim::contact::PairParameters p = test_pair();
-  shroudsim::hbm::ContactEvaluatorOptions o;
-  o.n_harmonics = 2;
-  o.n_time_samples = 64;
-  o.measure_plans = false;
+  const shroudsim::hbm::ContactEvaluatorOptions o = evaluator_options(2, 64);
   constexpr int kPairs = 3;
   ContactEvaluator ev(o, std::vector<shroudsim::contact::PairParameters>(kPairs, p));
   const Eigen::VectorXd w = random_states(ev, p, 20261201);
