@@ -74,12 +74,13 @@ int main(int argc, char** argv) {
                                    : forced::LinearSolverOptions::Kind::automatic;
     equations.set_linear_solver(so);
 
-    // The variable scaling, options and start of cmd_frf.cpp.
-    const continuation::ArclengthOptions ao = app::arclength_options(c, model, equations);
+    // The units, options and start of the frequency response (forced/frequency_response.hpp).
+    const continuation::ArclengthOptions ao =
+        forced::arclength_options(app::frequency_response_settings(c), model, equations);
 
     log::Stopwatch clock;
     std::string how;
-    const Eigen::VectorXd start = app::find_start(model, eo, equations, ao, ao.lambda_start, how);
+    const Eigen::VectorXd start = forced::find_start(model, eo, equations, ao, ao.lambda_start, how);
     std::replace(how.begin(), how.end(), ' ', '_');  // one key=value token in the output
     const double start_seconds = clock.seconds();
 

@@ -223,129 +223,14 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
   return o;
 }
 
-continuation::ArclengthOptions arclength_options(const io::Case& c, const ForcedModel& model,
-                                                 const forced::ReducedEquations& equations) {
-  // Scaled variables: the free linear contact motion over the range sets the unit of W,
-  // so that a resonance peak spans some tens of arclength units (PHYSICS.md section 7).
-  const auto& cn = c.continuation;
-  double motion = 0.0;
-  for (int i = 0; i <= 40; ++i) {
-    const double f = cn.frequency_start_hz + (cn.frequency_end_hz - cn.frequency_start_hz) * i / 40.0;
-    motion = std::max(motion, equations.linear_motion(f).lpNorm<Eigen::Infinity>());
-  }
-  double contact_scale = 0.0;
-  for (const auto& p : model.pairs)
-    contact_scale = std::max({contact_scale, p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness,
-                              std::abs(p.normal_preload) / p.normal_stiffness});
-  const double x_scale = motion > 0 ? motion / 20.0 : std::max(contact_scale, 1e-12);
-  continuation::ArclengthOptions ao;
-  ao.lambda_start = cn.frequency_start_hz;
-  ao.lambda_end = cn.frequency_end_hz;
-  ao.x_scale = Eigen::VectorXd::Constant(equations.size(), x_scale);
-  ao.initial_step = cn.initial_step;
-  // At least ~200 points over the range, whatever the step growth: a peak is never stepped over.
-  ao.max_step = std::max(1.0, std::abs(cn.frequency_end_hz - cn.frequency_start_hz) / (200.0 * cn.initial_step));
-  ao.max_points = cn.max_points;
-  ao.tolerance = c.hbm.tolerance;
-  return ao;
-}
-
-namespace {
-// The start search at one frequency (see find_start); throws NumericalError.
-Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
-                              forced::ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
-                              std::string& how) {
-  const double x_scale = ao.x_scale[0];
-  how = "stuck contact";
-  Eigen::VectorXd start = equations.stuck_solution(f);
-  if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
-  how = "free response";
-  start = equations.linear_motion(f);
-  if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
-  if (eo.n_harmonics > 1) {
-    // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
-    // each new harmonic starting at zero (higher harmonics are small corrections).
-    log::info("frf: start point at " + io::format_number(f) + " Hz by harmonic stepping (H = 1 .. " +
-              std::to_string(eo.n_harmonics) + ")");
-    Eigen::VectorXd prev;
-    int prev_h = 0;
-    for (int h = 1; h <= eo.n_harmonics; ++h) {
-      hbm::ContactEvaluatorOptions step_options = eo;
-      step_options.n_harmonics = h;
-      hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
-      forced::ReducedEquations step_equations(*model.linear, step_evaluator);
-      continuation::ArclengthOptions so = ao;
-      so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
-      Eigen::VectorXd w;
-      if (h == 1) {
-        w = step_equations.stuck_solution(f);
-        if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
-          w = step_equations.stuck_solution(f);
-          if (step_equations.solve_by_excitation_homotopy(f, so, w).status != continuation::BranchStatus::kReachedEnd)
-            break;
-        }
-      } else {
-        w = Eigen::VectorXd::Zero(step_equations.size());
-        const auto& lo = step_evaluator.pair_layout();
-        const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
-        for (int p = 0; p < step_evaluator.n_pairs(); ++p)
-          for (int d = 0; d < lo.n_directions(); ++d)
-            for (int n = 0; n <= prev_h; ++n)
-              for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
-                if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
-                w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
-              }
-        if (continuation::newton_fixed(step_equations, w, f, so) < 0) break;
-      }
-      prev = w;
-      prev_h = h;
-    }
-    if (prev_h == eo.n_harmonics) {
-      how = "harmonic stepping";
-      return prev;
-    }
-  }
-  how = "excitation homotopy";
-  start = equations.stuck_solution(f);
-  const continuation::Branch h = equations.solve_by_excitation_homotopy(f, ao, start);
-  if (h.status != continuation::BranchStatus::kReachedEnd)
-    throw NumericalError("no solution at the start frequency " + io::format_number(f) +
-                         " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
-                         h.message);
-  log::info("frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) + " points)");
-  return start;
-}
-}  // namespace
-
-Eigen::VectorXd find_start(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
-                           forced::ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
-                           std::string& how) {
-  try {
-    return find_start_at(model, eo, equations, ao, f, how);
-  } catch (const NumericalError&) {
-    // Every start can fail at one frequency and work a little way off it (the excitation
-    // homotopy meets a sampled stick-slip corner: seen at 80 Hz on the 0 and 15 degree
-    // contact angle cases). Start nearby, then walk to f by Newton at fixed frequencies.
-    for (double offset : {0.002, -0.002, 0.005, -0.005, 0.01, -0.01}) {
-      const double g = f * (1.0 + offset);
-      std::string how_g;
-      Eigen::VectorXd x;
-      try {
-        x = find_start_at(model, eo, equations, ao, g, how_g);
-      } catch (const NumericalError&) {
-        continue;
-      }
-      constexpr int kWalkSteps = 4;
-      bool ok = true;
-      for (int k = 1; k <= kWalkSteps && ok; ++k)
-        ok = continuation::newton_fixed(equations, x, g + (f - g) * k / kWalkSteps, ao) >= 0;
-      if (!ok) continue;
-      how = how_g + " at " + io::format_number(g) + " Hz, then Newton to " + io::format_number(f) + " Hz";
-      log::info("frf: start point at " + io::format_number(f) + " Hz from " + how);
-      return x;
-    }
-    throw;
-  }
+forced::FrequencyResponseSettings frequency_response_settings(const io::Case& c) {
+  forced::FrequencyResponseSettings s;
+  s.frequency_start_hz = c.continuation.frequency_start_hz;
+  s.frequency_end_hz = c.continuation.frequency_end_hz;
+  s.initial_step_hz = c.continuation.initial_step;
+  s.max_points = c.continuation.max_points;
+  s.tolerance = c.hbm.tolerance;
+  return s;
 }
 
 int cmd_frf(Context& ctx) {
@@ -361,95 +246,28 @@ int cmd_frf(Context& ctx) {
   hbm::ContactEvaluator evaluator(eo, model.pairs);
   forced::ReducedEquations equations(*model.linear, evaluator);
 
-  const continuation::ArclengthOptions ao = arclength_options(c, model, equations);
-  const double x_scale = ao.x_scale[0];
-
-  std::vector<forced::PointResult> results;
-  std::vector<int> iterations;
   log::info("frf: " + model.linear->describe() + ", " + std::to_string(evaluator.n_pairs()) + " contact pairs, " +
             std::to_string(equations.size()) + " unknowns (H = " + std::to_string(c.hbm.harmonics) +
             ", N = " + std::to_string(c.hbm.time_samples) + ", " + c.contact.model + ", " + c.hbm.jacobian + " Jacobian)");
-  std::string how;
-  const Eigen::VectorXd start = find_start(model, eo, equations, ao, ao.lambda_start, how);
-  ctx.report.section("frf")["start"] = how;
-  int piece = 0;
-  std::vector<int> pieces;
-  auto on_point = [&](const continuation::BranchPoint& p) {
-    results.push_back(equations.analyse(p.x, p.lambda));
-    iterations.push_back(p.newton_iterations);
-    pieces.push_back(piece);
+  int reported = 0;
+  auto progress = [&](const continuation::BranchPoint& p, int piece) {
+    ++reported;
     if (log::verbose()) {
       std::ostringstream s;
-      s << "frf: point " << results.size() << "  f = " << std::fixed << std::setprecision(3) << p.lambda
-        << " Hz  amplitude = " << std::scientific << std::setprecision(4) << results.back().amplitude
-        << " m  step " << std::defaultfloat << std::setprecision(3) << p.step << "  newton " << p.newton_iterations;
+      s << "frf: point " << reported << (piece ? " (piece 2)" : "") << "  f = " << std::setprecision(7) << p.lambda
+        << " Hz  step " << std::setprecision(3) << p.step << "  newton " << p.newton_iterations;
       log::info(s.str());
     }
   };
-  continuation::Branch branch = continuation::trace(equations, start, ao, on_point);
-  std::vector<continuation::BranchPoint> points = branch.points;
-  std::vector<int> point_piece(points.size(), 0);
-  // A branch that cannot reach the end of the range (it turned back through its start, e.g.
-  // along the twin of a branch that a sampled stick-slip state splits, or stalled at a corner)
-  // is completed from the other end: a second branch traced backwards from frequency_end_hz
-  // until it overlaps the first. The two pieces are listed one after the other (`piece`).
-  const double direction = ao.lambda_end > ao.lambda_start ? 1.0 : -1.0;
-  double reached = ao.lambda_start;
-  for (const auto& p : branch.points) reached = direction > 0 ? std::max(reached, p.lambda) : std::min(reached, p.lambda);
-  std::string first_message;
-  if (branch.status != continuation::BranchStatus::kReachedEnd && branch.status != continuation::BranchStatus::kStartFailed &&
-      branch.status != continuation::BranchStatus::kMaxPoints) {
-    first_message = branch.message;
-    log::info("frf: the branch from " + io::format_number(ao.lambda_start) + " Hz stopped (" + branch.message +
-              ") having reached " + io::format_number(reached) + " Hz; tracing back from " +
-              io::format_number(ao.lambda_end) + " Hz");
-    continuation::ArclengthOptions back = ao;
-    back.lambda_start = ao.lambda_end;
-    // Overlap the first piece by a few initial steps (within the range).
-    const double overlap = 4.0 * ao.initial_step * ao.lambda_scale;
-    back.lambda_end = direction > 0 ? std::max(ao.lambda_start, reached - overlap) : std::min(ao.lambda_start, reached + overlap);
-    back.max_points = std::max(1, ao.max_points - static_cast<int>(points.size()));
-    piece = 1;
-    try {
-      std::string back_how;
-      const Eigen::VectorXd back_start = find_start(model, eo, equations, ao, back.lambda_start, back_how);
-      ctx.report.section("frf")["start_second_piece"] = back_how;
-      const continuation::Branch second = continuation::trace(equations, back_start, back, on_point);
-      points.insert(points.end(), second.points.begin(), second.points.end());
-      point_piece.resize(points.size(), 1);
-      branch.turning_points += second.turning_points;
-      branch.newton_iterations += second.newton_iterations;
-      branch.rejected_steps += second.rejected_steps;
-      branch.rejected_turns += second.rejected_turns;
-      branch.kinks_crossed += second.kinks_crossed;
-      branch.reflections_crossed += second.reflections_crossed;
-      branch.residual_evaluations += second.residual_evaluations;
-      if (second.status == continuation::BranchStatus::kReachedEnd) {
-        branch.status = continuation::BranchStatus::kReachedEnd;
-        branch.message = "";
-        ctx.report.warn("the curve is in two pieces: the branch from " + io::format_number(ao.lambda_start) +
-                        " Hz stopped at " + io::format_number(reached) + " Hz (" + first_message +
-                        "); the rest was traced back from " + io::format_number(ao.lambda_end) +
-                        " Hz (frf.csv column `piece`)");
-      } else {
-        branch.message = first_message + "; tracing back from " + io::format_number(ao.lambda_end) +
-                         " Hz stopped too: " + second.message;
-      }
-    } catch (const NumericalError& e) {
-      branch.message = first_message + "; no start point at the end of the range either: " + e.what();
-    }
-  }
-  // Points dropped when a turning point was retraced are removed from the results as well.
-  std::vector<forced::PointResult> kept;
-  std::vector<int> kept_it, kept_piece;
-  for (std::size_t k = 0; k < points.size(); ++k)
-    for (std::size_t i = results.size(); i-- > 0;)
-      if (results[i].frequency_hz == points[k].lambda && pieces[i] == point_piece[k]) {
-        kept.push_back(results[i]);
-        kept_it.push_back(points[k].newton_iterations);
-        kept_piece.push_back(point_piece[k]);
-        break;
-      }
+  const forced::FrequencyResponse response = forced::trace_frequency_response(
+      frequency_response_settings(c), model, eo, equations, progress, [](const std::string& s) { log::info(s); });
+  const continuation::Branch& branch = response.summary;
+  const continuation::ArclengthOptions& ao = response.options;
+  const std::vector<forced::PointResult>& kept = response.results;
+  const std::vector<int>& kept_piece = response.piece;
+  ctx.report.section("frf")["start"] = response.start;
+  if (response.two_pieces) ctx.report.section("frf")["start_second_piece"] = response.start_second_piece;
+  for (const auto& w : response.warnings) ctx.report.warn(w);
 
   std::ostringstream csv;
   csv << "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations";
@@ -461,20 +279,25 @@ int cmd_frf(Context& ctx) {
   for (std::size_t i = 0; i < kept.size(); ++i) {
     const auto& r = kept[i];
     csv << io::format_number(r.frequency_hz) << "," << io::format_number(r.amplitude) << ","
-        << io::format_number(r.linear_amplitude) << "," << kept_it[i];
+        << io::format_number(r.linear_amplitude) << "," << response.points[i].newton_iterations;
     for (double a : r.harmonic_amplitudes) csv << "," << io::format_number(a);
     csv << "," << kept_piece[i] << "\n";
     max_energy_error = std::max(max_energy_error, r.energy_error);
     unconverged += r.unconverged_pairs;
-    if (r.amplitude > peak) peak = r.amplitude, peak_f = r.frequency_hz, peak_index = i;
+    if (r.amplitude > peak) peak_index = i;
   }
+  // The reported peak: the largest located resonance peak (the largest sampled point if none).
+  peak = kept.empty() ? 0.0 : kept[peak_index].amplitude;
+  peak_f = kept.empty() ? 0.0 : kept[peak_index].frequency_hz;
+  for (const auto& pk : response.peaks)
+    if (pk.amplitude_m >= peak) peak = pk.amplitude_m, peak_f = pk.frequency_hz, peak_index = pk.point;
   io::write_file_atomic(ctx.out_dir / "frf.csv", csv.str());
 
   // Hysteresis loops of every pair (at most 10) at the peak.
-  if (!points.empty()) {
+  if (!response.points.empty()) {
     std::ostringstream loops;
     loops << "pair,sample,x_m,y_m,z_m,tx_n,ty_n,n_n\n";
-    const Eigen::VectorXd& w = points[peak_index].x;
+    const Eigen::VectorXd& w = response.points[peak_index].x;
     const int block = evaluator.pair_layout().size();
     for (int p = 0; p < std::min(evaluator.n_pairs(), 10); ++p) {
       hbm::PairDetail d;
@@ -503,7 +326,19 @@ int cmd_frf(Context& ctx) {
   j["residual_evaluations"] = branch.residual_evaluations;
   j["unknowns"] = equations.size();
   j["contact_pairs"] = evaluator.n_pairs();
-  j["x_scale_m"] = x_scale;
+  j["x_scale_m"] = ao.x_scale.size() ? ao.x_scale[0] : 1.0;
+  j["frequency_unit_hz"] = ao.lambda_scale;
+  j["initial_step_units"] = ao.initial_step;
+  j["smooth_folds"] = branch.smooth_folds;
+  if (response.two_pieces) {
+    j["pieces_join"] = response.pieces_join;
+    j["join_distance"] = response.join_distance;
+  }
+  j["peaks"] = nlohmann::json::array();
+  for (const auto& pk : response.peaks)
+    j["peaks"].push_back({{"frequency_hz", pk.frequency_hz}, {"amplitude_m", pk.amplitude_m}, {"located", pk.located},
+                          {"piece", pk.piece}});
+  j["peak_location_seconds"] = response.peak_seconds;
   j["max_energy_balance_error"] = max_energy_error;
   j["peak_amplitude_m"] = peak;
   j["peak_frequency_hz"] = peak_f;

@@ -1,24 +1,23 @@
 #pragma once
-// Keller pseudo-arclength continuation of R(x, lambda) = 0 (PHYSICS.md section 7).
+// Keller pseudo-arclength continuation of R(x, lambda) = 0 (docs/continuation.md).
 //
-// Unknowns y = (x, lambda), scaled as y_s = (x ./ x_scale, lambda / lambda_scale). From a
-// converged point y_k with unit tangent t_k (in scaled variables), the predictor is
-// y_p = y_k + s t_k and the corrector is Newton on the augmented system
-//     R(x, lambda) = 0,   t_k . (y_s - y_p,s) = 0.
-// Step control: grow after few Newton iterations, shrink after many or on failure. When the
-// lambda component of the tangent changes sign (a turning point), the last `turning_backtrack`
-// points are dropped and the turn is retraced at a tenth of the step, unless the step already
-// moved lambda by less than a tenth of the initial step (a fold on a near-vertical stretch,
-// where a piecewise-smooth residual such as a friction law sampled in time zigzags by round-off
-// amounts: retracing there would only shrink the step without locating anything better). When
-// the x part of the tangent grows by more than `steep_ratio` between two points (a steep
-// branch), the step is capped at the initial step. A step whose tangent turns by more than
-// `max_turn_deg` is rejected and halved (it has most likely jumped to a nearby branch, or
-// cut a corner too sharp to follow); below
-// `kink_step` (relative to initial_step) it is accepted all the same, so that a true kink
-// of a nonsmooth residual does not stop the branch. When even a kink-size step finds no
-// solution (a corner sharper than a right angle: the branch goes on along the residual's other
-// piece), the null vector of the Jacobian just beyond the corner is tried, both ways.
+// Unknowns y = (x, lambda), scaled as y_s = (x ./ x_scale, lambda / lambda_scale): every step
+// and tolerance below is in these scaled units, so the caller chooses the units (the
+// frequency response takes them from the problem: forced/frequency_response.hpp). The
+// algorithm is built of separate pieces:
+//  - predictor: y_p = y_k + s t_k along the unit tangent;
+//  - corrector: Newton on R(y) = 0, t_k . (y - y_p) = 0 (scaled_system.hpp);
+//  - step control: from the Newton effort and the turn of the tangent (step_control.hpp);
+//    a step whose tangent turns by more than max_turn_deg is rejected (it has most likely
+//    jumped to a nearby branch) unless it is already at kink size (a true corner of a
+//    nonsmooth residual);
+//  - events (events.hpp): a fold (t_lambda changes sign) is located between the two points
+//    and inserted into the branch; a reflection at a corner (the branch comes straight back
+//    along itself after a fold) is undone and the corner crossed; a step that finds no
+//    solution even at kink size crosses the corner along the residual's other piece.
+// Options are validated on entry (std::invalid_argument). Only points that stay on the
+// branch reach on_point: points after a fold are reported once the reflection check has
+// passed them.
 //
 // Usage:
 //   MyResidual r;                        // implements ParametricResidual
@@ -85,14 +84,22 @@ struct ArclengthOptions {
   double tolerance = 1e-8;        ///< on the scaled residual, infinity norm
   int max_newton_iterations = 15;
   int target_newton_iterations = 4;  ///< grow the step below, shrink above
-  double steep_ratio = 30.0;      ///< "a" of the steep-branch rule (20 to 40)
-  int turning_backtrack = 2;      ///< points dropped before retracing a turning point
   double max_turn_deg = 30.0;     ///< largest angle between successive tangents (scaled)
+  double target_turn_deg = 20.0;  ///< step control aims at this turn per step (< max_turn_deg)
   double kink_step = 1e-3;        ///< relative to initial_step: below, large turns are accepted
   /// How far beyond lambda_start (against the direction of travel, in lambda units) the
   /// branch may go before it counts as having left the range (0: not at all).
   double start_slack = 0.0;
-  bool validate(std::vector<std::string>* errors) const;
+  /// n: the residual's size (x_scale and residual_scale must be empty or of size n).
+  bool validate(int n, std::vector<std::string>* errors) const;
+};
+
+/// What a point of a branch is.
+enum class PointKind {
+  kRegular,   ///< reached by a continuation step
+  kFold,      ///< a located fold (t_lambda = 0 to the corrector's tolerance)
+  kCorner,    ///< a located reversal of lambda at a corner of a nonsmooth branch
+  kBoundary,  ///< put on the end (or start) of the range by Newton at fixed lambda
 };
 
 struct BranchPoint {
@@ -102,6 +109,7 @@ struct BranchPoint {
   int newton_iterations = 0;
   double step = 0.0;              ///< arclength step that led here
   double residual_norm = 0.0;     ///< scaled, infinity norm
+  PointKind kind = PointKind::kRegular;
 };
 
 enum class BranchStatus { kReachedEnd, kLeftRange, kMaxPoints, kStepTooSmall, kStartFailed, kEvaluationFailed };
@@ -113,7 +121,8 @@ struct Branch {
   std::vector<BranchPoint> points;  ///< in continuation order
   BranchStatus status = BranchStatus::kReachedEnd;
   std::string message;              ///< why it stopped, for users
-  int turning_points = 0;           ///< folds passed (after retracing)
+  int turning_points = 0;           ///< folds and corner reversals passed (located, in points)
+  int smooth_folds = 0;             ///< of those, true folds (t_lambda -> 0)
   int newton_iterations = 0;        ///< total
   int rejected_steps = 0;           ///< corrector failures that shrank the step
   int rejected_turns = 0;           ///< of those, steps whose tangent turned too far (branch jumps)
@@ -127,7 +136,8 @@ int newton_fixed(ParametricResidual& residual, Eigen::VectorXd& x, double lambda
                  double* residual_norm = nullptr);
 
 /// Traces the branch from the solution near x_guess at lambda_start until lambda_end.
-/// on_point is called for every accepted point (may be empty).
+/// on_point is called for every point that stays on the branch, in order (may be empty).
+/// Throws std::invalid_argument when the options are invalid for this residual.
 Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const ArclengthOptions& options,
              const std::function<void(const BranchPoint&)>& on_point = {});
 

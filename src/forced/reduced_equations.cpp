@@ -386,16 +386,21 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
   bool ok = false;
   if (luf_valid_ && !refactor_ && luf_.rows() == n + 1) {
     int iterations = 0;
-    log::Stopwatch gmres_clock;
     ok = gmres(op, precondition, b, d, iterations);
-    krylov_seconds_since_factor_ += gmres_clock.seconds();
+    krylov_iterations_since_factor_ += iterations;
     stats_.krylov_iterations += iterations;
     if (ok) {
       ++stats_.krylov_solves;
       // Renew the factors when the lagged ones have become poor (many iterations) and the
-      // iterations since the last factorization have cost more than it did: for large n a
-      // factorization is worth hundreds of iterations.
-      refactor_ = iterations > solver_.refactor_after && krylov_seconds_since_factor_ > factor_seconds_;
+      // iterations since the last factorization have cost more than it did. The costs are
+      // counted, not timed, so that the path is the same on every run and machine: a
+      // factorization is (2/3) m^3 flops (m = n + 1) at BLAS-3 speed, an iteration is
+      // dominated by its two triangular solves, 2 m^2 flops at BLAS-2 speed, about
+      // kTriangularSlowdown times slower per flop: a factorization is worth m / 12 iterations.
+      constexpr double kTriangularSlowdown = 4.0;
+      const double m = static_cast<double>(n + 1);
+      refactor_ = iterations > solver_.refactor_after &&
+                  kTriangularSlowdown * 2.0 * m * m * krylov_iterations_since_factor_ > (2.0 / 3.0) * m * m * m;
     } else {
       ++stats_.krylov_failures;
     }
@@ -408,10 +413,8 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     Ad.topLeftCorner(n, n).noalias() = A.r_scale.cwiseInverse().asDiagonal() * J * A.x_scale.asDiagonal();
     Ad.col(n).head(n) = A.column;
     Ad.row(n) = A.row.transpose();
-    log::Stopwatch factor_clock;
     luf_.compute(Ad.cast<float>());
-    factor_seconds_ = factor_clock.seconds();
-    krylov_seconds_since_factor_ = 0.0;
+    krylov_iterations_since_factor_ = 0;
     ++stats_.dense_factorizations;
     luf_valid_ = true;
     refactor_ = false;

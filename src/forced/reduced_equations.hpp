@@ -23,7 +23,8 @@
 // harmonic (O(n b + c^2 H) instead of the O(n^2) of a dense product), right-preconditioned by
 // the single-precision LU factors of the dense bordered matrix of an earlier linearization.
 // J is formed densely only to renew those factors (when GMRES failed, or needed many
-// iterations that have cost more than the last factorization), never per evaluation, so the
+// iterations that have cost more flops than a factorization; counted, not timed, so the path
+// is reproducible), never per evaluation, so the
 // worst case is one dense LU per solve. The solution is checked by its true residual,
 // ||A d - b|| <= krylov_tolerance ||b||, in double precision.
 //
@@ -61,8 +62,8 @@ struct LinearSolverOptions {
   int krylov_min_size = 250;       ///< (n + 1) below which automatic uses the dense LU
   int krylov_max_iterations = 40;  ///< GMRES iterations before falling back to a new LU
   int refactor_after = 15;         ///< GMRES iterations above which the next solve refactors
-                                   ///< (matrix-free solves: once GMRES has also cost more
-                                   ///< time than the last factorization)
+                                   ///< (matrix-free solves: once the GMRES iterations since
+                                   ///< the last factorization have also cost more flops)
   double krylov_tolerance = 1e-11; ///< relative true residual ||A d - b|| / ||b||
 };
 
@@ -194,8 +195,7 @@ class ReducedEquations : public continuation::ParametricResidual {
   // Lagged preconditioner: LU factors of an earlier augmented matrix.
   Eigen::PartialPivLU<Eigen::MatrixXf> luf_;  // single precision
   bool luf_valid_ = false, refactor_ = false;
-  double factor_seconds_ = 0.0;               // the last single-precision factorization
-  double krylov_seconds_since_factor_ = 0.0;  // GMRES time since then
+  long krylov_iterations_since_factor_ = 0;   // GMRES iterations since the last factorization
 };
 
 }  // namespace shroudsim::forced

@@ -43,6 +43,10 @@ class LinearPart {
   /// [J], given the complex contact forces F_n (n = 0..H, each of size c) at frequency w.
   virtual void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
                       double& viscous_dissipation) const = 0;
+  /// The undamped natural frequencies [Hz] at which the excitation (temporal harmonic 1)
+  /// drives this linear part, ascending: where its free response peaks. Used to size the
+  /// continuation's displacement unit (forced/frequency_response.hpp); empty if unknown.
+  virtual std::vector<double> resonances_hz() const { return {}; }
   /// Human-readable description (for run.json).
   virtual std::string describe() const = 0;
 };

@@ -1,6 +1,8 @@
 #include "frf/lumped.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -81,6 +83,16 @@ void LumpedLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& for
     // Work of f = Re(F e^{i w t}) on u: pi Im(F conj(U)).
     if (n == 1) excitation_work += kPi * (force_ * std::conj(u[excited_dof_])).imag();
   }
+}
+
+std::vector<double> LumpedLinearPart::resonances_hz() const {
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(k_, m_, Eigen::EigenvaluesOnly);
+  std::vector<double> f;
+  if (eig.info() != Eigen::Success) return f;
+  for (Eigen::Index i = 0; i < eig.eigenvalues().size(); ++i)
+    if (eig.eigenvalues()[i] > 0) f.push_back(std::sqrt(eig.eigenvalues()[i]) / (2.0 * std::numbers::pi));
+  std::sort(f.begin(), f.end());
+  return f;
 }
 
 std::string LumpedLinearPart::describe() const {

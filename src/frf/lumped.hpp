@@ -31,6 +31,8 @@ class LumpedLinearPart : public LinearPart {
   void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
               double& viscous_dissipation) const override;
   std::string describe() const override;
+  /// sqrt(eig(K, M)) / 2 pi.
+  std::vector<double> resonances_hz() const override;
 
   /// B (c x ndof): relative displacement operator of the contacts.
   const Eigen::MatrixXd& contact_operator() const { return b_; }

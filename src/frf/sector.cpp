@@ -170,6 +170,15 @@ void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& for
   }
 }
 
+std::vector<double> SectorLinearPart::resonances_hz() const {
+  std::vector<double> f;
+  const auto it = dynamic_.find(harmonic_index(1));
+  if (it == dynamic_.end()) return f;
+  for (Eigen::Index r = 0; r < it->second.omega.size(); ++r) f.push_back(it->second.omega[r] / (2.0 * std::numbers::pi));
+  std::sort(f.begin(), f.end());
+  return f;
+}
+
 std::string SectorLinearPart::describe() const {
   std::ostringstream s;
   s << "FE sector (Nb = " << sectors_ << ", engine order " << forcing_.engine_order << ", harmonic indices";

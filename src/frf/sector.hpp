@@ -57,6 +57,8 @@ class SectorLinearPart : public LinearPart {
   void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
               double& viscous_dissipation) const override;
   std::string describe() const override;
+  /// The modal frequencies of harmonic index h_1 (the engine order's).
+  std::vector<double> resonances_hz() const override;
 
   /// Harmonic index of temporal harmonic n.
   int harmonic_index(int n) const;

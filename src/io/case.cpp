@@ -543,7 +543,16 @@ void read_all(Reader& r, Case& c) {
   cn.frequency_end_hz = r.number("continuation.frequency_end_hz", positive);
   if (cn.frequency_end_hz == cn.frequency_start_hz)
     r.violates("continuation.frequency_end_hz", r.node("continuation.frequency_end_hz"), "frequency_end_hz != frequency_start_hz");
-  cn.initial_step = r.number("continuation.initial_step", positive);
+  {
+    const std::string key = "continuation.initial_step";
+    const toml::node& n = r.node(key);
+    if (auto v = n.as_string()) {
+      if (v->get() != "auto") r.violates(key, n, "a number > 0 (Hz-equivalent) or \"auto\"");
+      cn.initial_step = 0.0;  // auto
+    } else {
+      cn.initial_step = r.number(key, positive);
+    }
+  }
   cn.max_points = r.integer("continuation.max_points", in_range_int(1, 1'000'000));
 
   c.motion.x = r.motion("motion.x");

@@ -107,7 +107,7 @@ struct HbmSection {
 struct ContinuationSection {
   double frequency_start_hz = 100.0;
   double frequency_end_hz = 220.0;
-  double initial_step = 0.5;
+  double initial_step = 0.0;             ///< Hz-equivalent arclength; 0: "auto" (docs/continuation.md)
   int max_points = 5000;
 };
 

@@ -92,7 +92,7 @@ const std::vector<KeySpec>& case_schema() {
 
       {"continuation.frequency_start_hz", "100.0", "> 0", "start of the frequency range (Hz)"},
       {"continuation.frequency_end_hz", "220.0", "> 0, != start", "end of the frequency range (Hz)"},
-      {"continuation.initial_step", "0.5", "> 0", "initial arclength step (Hz-equivalent)"},
+      {"continuation.initial_step", "\"auto\"", "> 0 or \"auto\"", "initial arclength step: \"auto\" (1/400 of the range) or Hz-equivalent; never above 1/200 of the range"},
       {"continuation.max_points", "5000", "1 <= points <= 1000000", "maximum number of solution points"},
 
       {"motion.x", "[[1, 1e-5, 0.0]]", "rows [harmonic >= 0, cos, sin]", "relative tangential motion x(t) (m)"},

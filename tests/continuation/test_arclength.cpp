@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <vector>
 
 #include "continuation/arclength.hpp"
+#include "continuation/events.hpp"
 
 namespace shroudsim::continuation {
 namespace {
@@ -99,14 +102,19 @@ TEST(Arclength, PassesATurningPointAndReportsLeavingTheRange) {
   EXPECT_NEAR(b.points.front().x[0], 1.0, 1e-8);
   EXPECT_NEAR(b.points.back().x[0], -1.0, 1e-6);
   for (const auto& p : b.points) EXPECT_NEAR(p.x[0] * p.x[0] + p.lambda * p.lambda, 1.0, 1e-7);
-  // The turn was retraced at a tenth of the step: some step is a tenth of the largest before it.
-  bool retraced = false;
-  double largest = 0.0;
-  for (std::size_t i = 1; i < b.points.size(); ++i) {
-    retraced |= b.points[i].step <= 0.1 * largest * (1 + 1e-12);
-    largest = std::max(largest, b.points[i].step);
+  // The turn is an event, located and inserted into the branch: (x, lambda) = (0, 1) to the
+  // corrector's tolerance (the residual x^2 + lambda^2 - 1 <= 1e-8 moves lambda by 5e-9 at
+  // x = 0; t_lambda is linear in the arclength there, false position locates it).
+  int folds = 0;
+  for (const auto& p : b.points) {
+    if (p.kind != PointKind::kFold) continue;
+    ++folds;
+    EXPECT_NEAR(p.lambda, 1.0, o.tolerance);
+    EXPECT_NEAR(p.x[0], 0.0, 1e-6);
+    EXPECT_LT(std::abs(p.tangent[1]), 1e-6);
   }
-  EXPECT_TRUE(retraced);
+  EXPECT_EQ(folds, 1);
+  EXPECT_EQ(b.smooth_folds, 1);
 }
 
 /// x^2 = eps^2 (1 - lambda): a hairpin fold at lambda = 1 whose two sides are 2 eps
@@ -246,6 +254,160 @@ TEST(Arclength, ASharpCornerOfANonsmoothBranchIsCrossed) {
   for (const auto& p : b.points) EXPECT_NEAR(p.x[0], 3.0 * std::abs(p.lambda - 1.0), 1e-10) << p.lambda;
   // Frequency-like parameter: it only moves forward (the corner is not a fold).
   for (std::size_t i = 1; i < b.points.size(); ++i) EXPECT_GT(b.points[i].lambda, b.points[i - 1].lambda);
+}
+
+}  // namespace
+}  // namespace shroudsim::continuation
+
+namespace shroudsim::continuation {
+namespace {
+
+/// The closed-form amplitude relation of Duffing above, G(u, w) = (k^2 + 4 z^2 w^2) u - F^2
+/// with u = A^2 and k = 1 - w^2 + 3/4 g u, solved independently of the continuation.
+struct DuffingClosedForm {
+  double z, g, f;
+  /// A fold in w: G = 0 and dG/du = 0, by Newton from (u, w).
+  std::pair<double, double> fold_from(double u, double w) const {
+    for (int it = 0; it < 50; ++it) {
+      const double k = 1 - w * w + 0.75 * g * u;
+      const double G = (k * k + 4 * z * z * w * w) * u - f * f;
+      const double H = k * k + 4 * z * z * w * w + 1.5 * g * u * k;  // dG/du
+      const double Gw = (-4 * w * k + 8 * z * z * w) * u;
+      const double Hu = 3 * g * k + 1.125 * g * g * u, Hw = -4 * w * k + 8 * z * z * w - 3 * g * u * w;
+      const double det = H * Hw - Gw * Hu;
+      const double du = -(G * Hw - Gw * H) / det, dw = -(H * H - Hu * G) / det;
+      u += du;
+      w += dw;
+      if (std::abs(du) < 1e-16 * u && std::abs(dw) < 1e-16 * w) break;
+    }
+    return {u, w};
+  }
+  /// The largest amplitude along the curve: dG/dw = 0 gives k = 2 z^2, then G = 0 in u alone.
+  double peak_amplitude() const {
+    auto G = [&](double u) { return (4 * std::pow(z, 4) + 4 * z * z * (1 + 0.75 * g * u - 2 * z * z)) * u - f * f; };
+    double lo = 0.0, hi = 10.0;
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (G(mid) > 0 ? hi : lo) = mid;
+    }
+    return std::sqrt(0.5 * (lo + hi));
+  }
+};
+
+ArclengthOptions duffing_options(double step) {
+  ArclengthOptions o;
+  o.lambda_start = 0.5;
+  o.lambda_end = 1.5;
+  o.x_scale = Eigen::VectorXd::Constant(2, 0.05);
+  o.initial_step = step;
+  o.tolerance = 1e-12;
+  return o;
+}
+
+TEST(ArclengthEvents, DuffingFoldsAreLocatedToTheClosedForm) {
+  Duffing duffing(0.01, 1.0, 0.01);
+  const DuffingClosedForm exact{0.01, 1.0, 0.01};
+  const Branch b = trace(duffing, Eigen::VectorXd::Zero(2), duffing_options(0.02));
+  ASSERT_EQ(b.status, BranchStatus::kReachedEnd) << b.message;
+  int folds = 0;
+  for (const auto& p : b.points) {
+    if (p.kind != PointKind::kFold) continue;
+    ++folds;
+    const auto [u, w] = exact.fold_from(p.x.squaredNorm(), p.lambda);
+    // lambda at the fold to 1e-8 relative (the goal): the fold is a quadratic
+    // extremum of lambda along the branch, so a located arclength error e moves lambda by
+    // ~ curvature * e^2.
+    EXPECT_NEAR(p.lambda, w, 1e-8 * w);
+    EXPECT_NEAR(p.x.squaredNorm(), u, 1e-5 * u);
+  }
+  EXPECT_EQ(folds, 2);
+  EXPECT_EQ(b.smooth_folds, 2);
+}
+
+TEST(ArclengthEvents, PeakLocationDoesNotDependOnTheStep) {
+  Duffing duffing(0.01, 1.0, 0.01);
+  const double exact = DuffingClosedForm{0.01, 1.0, 0.01}.peak_amplitude();
+  auto amplitude = [](const Eigen::VectorXd& x, double) { return x.norm(); };
+  std::vector<double> located;
+  for (double step : {0.005, 0.02, 0.08}) {
+    const ArclengthOptions o = duffing_options(step);
+    const Branch b = trace(duffing, Eigen::VectorXd::Zero(2), o);
+    ASSERT_EQ(b.status, BranchStatus::kReachedEnd) << b.message;
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < b.points.size(); ++i)
+      if (b.points[i].x.norm() > b.points[k].x.norm()) k = i;
+    ASSERT_GT(k, 0u);
+    ASSERT_LT(k + 1, b.points.size());
+    double best = b.points[k].x.norm();
+    const double sampled = best;
+    for (std::size_t from : {k - 1, k}) {
+      const BranchPoint& p = b.points[from];
+      const BranchPoint& q = b.points[from + 1];
+      Eigen::VectorXd dy(3);
+      dy << (q.x - p.x) / 0.05, q.lambda - p.lambda;
+      const Extremum e = locate_maximum(duffing, o, p, p.tangent.dot(dy), amplitude);
+      if (e.found) best = std::max(best, e.value);
+    }
+    // The sampled maximum is off by the square of the distance to the peak; the located one
+    // only by the corrector's tolerance.
+    EXPECT_NEAR(best, exact, 1e-9 * exact) << "step " << step << ", sampled " << sampled;
+    located.push_back(best);
+  }
+  EXPECT_NEAR(located[0], located[2], 1e-9 * located[0]);
+}
+
+TEST(ArclengthEvents, InvalidOptionsAreRefusedOnEntry) {
+  Duffing duffing(0.01, 1.0, 0.01);
+  ArclengthOptions o = duffing_options(0.02);
+  o.x_scale = Eigen::VectorXd::Constant(3, 0.05);  // the residual has 2 unknowns
+  EXPECT_THROW(trace(duffing, Eigen::VectorXd::Zero(2), o), std::invalid_argument);
+  o = duffing_options(0.02);
+  EXPECT_THROW(trace(duffing, Eigen::VectorXd::Zero(3), o), std::invalid_argument);
+  o.lambda_scale = 0.0;
+  EXPECT_THROW(trace(duffing, Eigen::VectorXd::Zero(2), o), std::invalid_argument);
+  o = duffing_options(0.02);
+  o.residual_scale = Eigen::VectorXd::Constant(2, std::nan(""));
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
+  EXPECT_THROW(newton_fixed(duffing, x, 0.5, o), std::invalid_argument);
+}
+
+/// (x - lambda)(x - lambda - d) = 0: two parallel branches a distance d apart in x, like the
+/// twins a sampled friction law makes.
+class Twins : public ParametricResidual {
+ public:
+  explicit Twins(double d) : d_(d) {}
+  int size() const override { return 1; }
+  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd*) override {
+    const double a = x[0] - l, b = x[0] - l - d_;
+    r = Eigen::VectorXd::Constant(1, a * b);
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, a + b);
+    return true;
+  }
+
+ private:
+  double d_;
+};
+
+TEST(ArclengthEvents, APieceJoinsItsOwnBranchAndNotATwin) {
+  Twins twins(1e-3);
+  ArclengthOptions o;
+  o.lambda_start = 0.0;
+  o.lambda_end = 1.0;
+  o.initial_step = 0.05;
+  o.tolerance = 1e-12;
+  const Branch lower = trace(twins, Eigen::VectorXd::Constant(1, 0.0), o);
+  ASSERT_EQ(lower.status, BranchStatus::kReachedEnd);
+  // Traced back from the end on the same branch: joins.
+  ArclengthOptions back = o;
+  back.lambda_start = 1.0;
+  back.lambda_end = 0.4;
+  const Branch same = trace(twins, Eigen::VectorXd::Constant(1, 1.0), back);
+  ASSERT_EQ(same.status, BranchStatus::kReachedEnd);
+  EXPECT_LT(distance_to_branch(twins, o, lower.points, same.points.back()), 1e-9);
+  // From the end on the twin: the twin's point lies 1e-3 / sqrt(2) off the first branch.
+  const Branch twin = trace(twins, Eigen::VectorXd::Constant(1, 1.0 + 1e-3), back);
+  ASSERT_EQ(twin.status, BranchStatus::kReachedEnd);
+  EXPECT_NEAR(distance_to_branch(twins, o, lower.points, twin.points.back()), 1e-3 / std::sqrt(2.0), 1e-6);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "continuation/arclength.hpp"
+#include "forced/frequency_response.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/lumped.hpp"
 #include "hbm/contact_evaluator.hpp"
@@ -45,8 +46,11 @@ TEST_P(Extremes, ConvergeToTheLimitOrStopCleanly) {
   const double m = 1.0, k = std::pow(2 * kPi * 10.0, 2), c = 2 * e.zeta * std::sqrt(k * m), force = 1.0;
   frf::LumpedContact lc;
   lc.dof = one_d ? std::array<int, 3>{0, -1, -1} : std::array<int, 3>{0, 1, 2};
-  const frf::LumpedLinearPart linear(Eigen::MatrixXd::Identity(dofs, dofs) * m, Eigen::MatrixXd::Identity(dofs, dofs) * k,
-                                     Eigen::MatrixXd::Identity(dofs, dofs) * c, {lc}, 0, force, 0);
+  ForcedModel model;
+  model.linear = std::make_unique<frf::LumpedLinearPart>(Eigen::MatrixXd::Identity(dofs, dofs) * m,
+                                                         Eigen::MatrixXd::Identity(dofs, dofs) * k,
+                                                         Eigen::MatrixXd::Identity(dofs, dofs) * c,
+                                                         std::vector<frf::LumpedContact>{lc}, 0, force, 0);
   contact::PairParameters pair;
   pair.tangential_stiffness = e.kt;
   pair.normal_stiffness = e.kn;
@@ -57,23 +61,20 @@ TEST_P(Extremes, ConvergeToTheLimitOrStopCleanly) {
   o.n_time_samples = e.n;
   o.law.model = e.model;
   o.threads = 1;
-  hbm::ContactEvaluator ev(o, {pair});
-  ReducedEquations eq(linear, ev);
+  model.pairs = {pair};
+  hbm::ContactEvaluator ev(o, model.pairs);
+  ReducedEquations eq(*model.linear, ev);
 
-  continuation::ArclengthOptions opt;
-  opt.lambda_start = 5.0;
-  opt.lambda_end = 25.0;
-  opt.initial_step = 0.2;
-  opt.max_step = 20.0 / (200 * 0.2);  // at least ~200 points over the range, as the frf command
-  opt.max_points = 4000;
-  opt.tolerance = 1e-9;
-  // Scaled as the frf command scales: 1/20 of the largest free motion over the range.
-  double motion = 0.0;
-  for (int i = 0; i <= 40; ++i) motion = std::max(motion, eq.linear_motion(5.0 + 20.0 * i / 40).lpNorm<Eigen::Infinity>());
-  opt.x_scale = Eigen::VectorXd::Constant(eq.size(), motion / 20);
-  Eigen::VectorXd start = eq.stuck_solution(opt.lambda_start);
-  if (continuation::newton_fixed(eq, start, opt.lambda_start, opt) < 0) start = eq.linear_motion(opt.lambda_start);
-  const continuation::Branch b = continuation::trace(eq, start, opt);
+  // The frequency response as the frf command traces it (units from the problem, start
+  // search, second piece), with the default continuation settings.
+  FrequencyResponseSettings settings;
+  settings.frequency_start_hz = 5.0;
+  settings.frequency_end_hz = 25.0;
+  settings.max_points = 4000;
+  settings.tolerance = 1e-9;
+  const FrequencyResponse response = trace_frequency_response(settings, model, o, eq);
+  continuation::Branch b = response.summary;
+  b.points = response.points;
   ASSERT_FALSE(b.points.empty()) << b.message;
   if (b.status != continuation::BranchStatus::kReachedEnd) {
     // A stop is allowed only with a reason and what was computed; this matrix expects none.

@@ -1,0 +1,320 @@
+#include "forced/frequency_response.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "continuation/events.hpp"
+#include "core/error.hpp"
+
+namespace shroudsim::forced {
+namespace {
+
+std::string number(double v) {
+  char buf[32];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+using Info = std::function<void(const std::string&)>;
+
+// Scaled distance (a range spans 100 units, a free peak 20) within which the second piece's
+// end lies on the first piece: far below a step (>= 1e-6 * 0.25 units) and far above the
+// corrector's tolerance (1e-8 on the scaled residual).
+constexpr double kJoinTolerance = 1e-5;
+void say(const Info& info, const std::string& s) {
+  if (info) info(s);
+}
+
+// The start search at one frequency (see find_start); throws NumericalError.
+Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                              ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
+                              std::string& how, const Info& info) {
+  const double x_scale = ao.x_scale[0];
+  how = "stuck contact";
+  Eigen::VectorXd start = equations.stuck_solution(f);
+  if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
+  how = "free response";
+  start = equations.linear_motion(f);
+  if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
+  if (eo.n_harmonics > 1) {
+    // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
+    // each new harmonic starting at zero (higher harmonics are small corrections).
+    say(info, "frf: start point at " + number(f) + " Hz by harmonic stepping (H = 1 .. " +
+                  std::to_string(eo.n_harmonics) + ")");
+    Eigen::VectorXd prev;
+    int prev_h = 0;
+    for (int h = 1; h <= eo.n_harmonics; ++h) {
+      hbm::ContactEvaluatorOptions step_options = eo;
+      step_options.n_harmonics = h;
+      hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
+      ReducedEquations step_equations(*model.linear, step_evaluator);
+      continuation::ArclengthOptions so = ao;
+      so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
+      Eigen::VectorXd w;
+      if (h == 1) {
+        w = step_equations.stuck_solution(f);
+        if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
+          w = step_equations.stuck_solution(f);
+          if (step_equations.solve_by_excitation_homotopy(f, so, w).status != continuation::BranchStatus::kReachedEnd)
+            break;
+        }
+      } else {
+        w = Eigen::VectorXd::Zero(step_equations.size());
+        const auto& lo = step_evaluator.pair_layout();
+        const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
+        for (int p = 0; p < step_evaluator.n_pairs(); ++p)
+          for (int d = 0; d < lo.n_directions(); ++d)
+            for (int n = 0; n <= prev_h; ++n)
+              for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
+                if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
+                w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
+              }
+        if (continuation::newton_fixed(step_equations, w, f, so) < 0) break;
+      }
+      prev = w;
+      prev_h = h;
+    }
+    if (prev_h == eo.n_harmonics) {
+      how = "harmonic stepping";
+      return prev;
+    }
+  }
+  how = "excitation homotopy";
+  start = equations.stuck_solution(f);
+  const continuation::Branch h = equations.solve_by_excitation_homotopy(f, ao, start);
+  if (h.status != continuation::BranchStatus::kReachedEnd)
+    throw NumericalError("no solution at the start frequency " + number(f) +
+                         " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
+                         h.message);
+  say(info, "frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) +
+                " points)");
+  return start;
+}
+
+Eigen::VectorXd find_start_logged(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                                  ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
+                                  std::string& how, const Info& info) {
+  try {
+    return find_start_at(model, eo, equations, ao, f, how, info);
+  } catch (const NumericalError&) {
+    // Every start can fail at one frequency and work a little way off it (the excitation
+    // homotopy meets a sampled stick-slip corner). Start nearby, then walk to f by Newton at
+    // fixed frequencies.
+    for (double offset : {0.002, -0.002, 0.005, -0.005, 0.01, -0.01}) {
+      const double g = f * (1.0 + offset);
+      std::string how_g;
+      Eigen::VectorXd x;
+      try {
+        x = find_start_at(model, eo, equations, ao, g, how_g, info);
+      } catch (const NumericalError&) {
+        continue;
+      }
+      constexpr int kWalkSteps = 4;
+      bool ok = true;
+      for (int k = 1; k <= kWalkSteps && ok; ++k)
+        ok = continuation::newton_fixed(equations, x, g + (f - g) * k / kWalkSteps, ao) >= 0;
+      if (!ok) continue;
+      how = how_g + " at " + number(g) + " Hz, then Newton to " + number(f) + " Hz";
+      say(info, "frf: start point at " + number(f) + " Hz from " + how);
+      return x;
+    }
+    throw;
+  }
+}
+
+void add_counts(continuation::Branch& to, const continuation::Branch& b) {
+  to.turning_points += b.turning_points;
+  to.smooth_folds += b.smooth_folds;
+  to.newton_iterations += b.newton_iterations;
+  to.rejected_steps += b.rejected_steps;
+  to.rejected_turns += b.rejected_turns;
+  to.kinks_crossed += b.kinks_crossed;
+  to.reflections_crossed += b.reflections_crossed;
+  to.residual_evaluations += b.residual_evaluations;
+}
+
+}  // namespace
+
+double free_motion_peak(const frf::LinearPart& linear, const ReducedEquations& equations, double f_start,
+                        double f_end) {
+  std::vector<double> at;
+  for (int i = 0; i <= 40; ++i) at.push_back(f_start + (f_end - f_start) * i / 40.0);
+  const double lo = std::min(f_start, f_end), hi = std::max(f_start, f_end);
+  for (double f : linear.resonances_hz())
+    if (f > lo && f < hi) at.push_back(f);
+  double motion = 0.0;
+  for (double f : at) motion = std::max(motion, equations.linear_motion(f).lpNorm<Eigen::Infinity>());
+  return motion;
+}
+
+continuation::ArclengthOptions arclength_options(const FrequencyResponseSettings& s, const ForcedModel& model,
+                                                 const ReducedEquations& equations) {
+  const double motion = free_motion_peak(*model.linear, equations, s.frequency_start_hz, s.frequency_end_hz);
+  double contact_scale = 0.0;
+  for (const auto& p : model.pairs)
+    contact_scale = std::max({contact_scale, p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness,
+                              std::abs(p.normal_preload) / p.normal_stiffness});
+  const double x_unit = motion > 0 ? motion / kFreePeakUnits
+                                   : (contact_scale > 0 && std::isfinite(contact_scale) ? contact_scale : 1.0);
+  const double lambda_unit = std::abs(s.frequency_end_hz - s.frequency_start_hz) / kRangeUnits;
+  continuation::ArclengthOptions ao;
+  ao.lambda_start = s.frequency_start_hz;
+  ao.lambda_end = s.frequency_end_hz;
+  ao.lambda_scale = lambda_unit;
+  ao.x_scale = Eigen::VectorXd::Constant(equations.size(), x_unit);
+  const double requested = s.initial_step_hz > 0 ? s.initial_step_hz / lambda_unit : kAutoInitialStep;
+  ao.initial_step = std::min(requested, kMaxStep);
+  ao.max_step = kMaxStep / ao.initial_step;
+  ao.max_points = s.max_points;
+  ao.tolerance = s.tolerance;
+  return ao;
+}
+
+Eigen::VectorXd find_start(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                           ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
+                           std::string& how) {
+  return find_start_logged(model, eo, equations, ao, f, how, {});
+}
+
+std::vector<std::size_t> prominent_maxima(const std::vector<double>& a, double min_prominence) {
+  std::vector<std::size_t> out;
+  const std::size_t m = a.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const bool left_ok = i == 0 || a[i] > a[i - 1];
+    const bool right_ok = i + 1 == m || a[i] >= a[i + 1];
+    if (!left_ok || !right_ok) continue;
+    double left_min = a[i], right_min = a[i];
+    for (std::size_t j = i; j-- > 0 && a[j] <= a[i];) left_min = std::min(left_min, a[j]);
+    for (std::size_t j = i + 1; j < m && a[j] <= a[i]; ++j) right_min = std::min(right_min, a[j]);
+    // At an end of the curve the drop is only known on one side.
+    const double base = i == 0 ? right_min : i + 1 == m ? left_min : std::max(left_min, right_min);
+    if (a[i] > 0 && a[i] - base >= min_prominence * a[i]) out.push_back(i);
+  }
+  return out;
+}
+
+FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& settings, const ForcedModel& model,
+                                           const hbm::ContactEvaluatorOptions& eo, ReducedEquations& equations,
+                                           const std::function<void(const continuation::BranchPoint&, int)>& progress,
+                                           const Info& info) {
+  FrequencyResponse out;
+  const continuation::ArclengthOptions ao = arclength_options(settings, model, equations);
+  out.options = ao;
+  out.start = "";
+  const Eigen::VectorXd start = find_start_logged(model, eo, equations, ao, ao.lambda_start, out.start, info);
+  continuation::Branch first =
+      continuation::trace(equations, start, ao, [&](const continuation::BranchPoint& p) { if (progress) progress(p, 0); });
+  out.points = first.points;
+  out.piece.assign(out.points.size(), 0);
+  out.summary = first;
+  out.summary.points.clear();
+
+  // A branch that cannot reach the end of the range (it turned back through its start, or
+  // stalled at a corner) is completed from the other end: a second piece traced backwards
+  // from frequency_end_hz until it overlaps the first. It is kept only if it provably joins
+  // the first: its last point, inside the first piece's range, lies on the first piece (the
+  // corrector from the nearest point of the first piece, on the hyperplane through it, finds
+  // that very point).
+  const double direction = ao.lambda_end > ao.lambda_start ? 1.0 : -1.0;
+  double reached = ao.lambda_start;
+  for (const auto& p : first.points) reached = direction > 0 ? std::max(reached, p.lambda) : std::min(reached, p.lambda);
+  if (first.status != continuation::BranchStatus::kReachedEnd && first.status != continuation::BranchStatus::kStartFailed &&
+      first.status != continuation::BranchStatus::kMaxPoints) {
+    const std::string first_message = first.message;
+    say(info, "frf: the branch from " + number(ao.lambda_start) + " Hz stopped (" + first.message +
+                  ") having reached " + number(reached) + " Hz; tracing back from " + number(ao.lambda_end) + " Hz");
+    continuation::ArclengthOptions back = ao;
+    back.lambda_start = ao.lambda_end;
+    const double overlap = 4.0 * ao.initial_step * ao.lambda_scale;
+    back.lambda_end = direction > 0 ? std::max(ao.lambda_start, reached - overlap) : std::min(ao.lambda_start, reached + overlap);
+    back.max_points = std::max(1, ao.max_points - static_cast<int>(out.points.size()));
+    out.two_pieces = true;
+    try {
+      const Eigen::VectorXd back_start =
+          find_start_logged(model, eo, equations, ao, back.lambda_start, out.start_second_piece, info);
+      const continuation::Branch second = continuation::trace(equations, back_start, back);
+      add_counts(out.summary, second);
+      // The join check.
+      bool joined = false;
+      out.join_distance = std::numeric_limits<double>::infinity();
+      if (!second.points.empty()) {
+        out.join_distance = continuation::distance_to_branch(equations, ao, first.points, second.points.back());
+        // Two solutions of the same equations to tolerance agree far within a step.
+        joined = out.join_distance <= kJoinTolerance;
+      }
+      out.pieces_join = joined;
+      if (!joined) {
+        out.summary.status = continuation::BranchStatus::kEvaluationFailed;
+        out.summary.message = first_message + "; the branch traced back from " + number(ao.lambda_end) +
+                              " Hz does not join it (scaled distance " + number(out.join_distance) +
+                              "): two separate branches, the range is not covered by one";
+      } else if (second.status == continuation::BranchStatus::kReachedEnd) {
+        out.summary.status = continuation::BranchStatus::kReachedEnd;
+        out.summary.message = "";
+        out.warnings.push_back("the curve is in two pieces: the branch from " + number(ao.lambda_start) +
+                               " Hz stopped at " + number(reached) + " Hz (" + first_message +
+                               "); the rest was traced back from " + number(ao.lambda_end) +
+                               " Hz and joins it (frf.csv column `piece`)");
+      } else {
+        out.summary.message = first_message + "; tracing back from " + number(ao.lambda_end) + " Hz stopped too: " +
+                              second.message;
+      }
+      for (const auto& p : second.points) {
+        out.points.push_back(p);
+        out.piece.push_back(1);
+        if (progress) progress(p, 1);
+      }
+    } catch (const NumericalError& e) {
+      out.summary.message = first_message + "; no start point at the end of the range either: " + e.what();
+    }
+  }
+
+  for (const auto& p : out.points) out.results.push_back(equations.analyse(p.x, p.lambda));
+
+  // Resonance peaks, located along the branch.
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int pc = 0; pc <= 1; ++pc) {
+    std::vector<std::size_t> idx;
+    std::vector<double> amp;
+    for (std::size_t i = 0; i < out.points.size(); ++i)
+      if (out.piece[i] == pc) idx.push_back(i), amp.push_back(out.results[i].amplitude);
+    constexpr double kMinProminence = 0.02;  // a local maximum 2 % above its surroundings
+    for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
+      const std::size_t i = idx[m];
+      ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false};
+      if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
+        int evaluations = 0;
+        continuation::ScaledSystem sys(equations, ao, &evaluations);
+        auto amplitude = [&](const Eigen::VectorXd& x, double lambda) { return equations.analyse(x, lambda).amplitude; };
+        // On the two steps beside the sampled maximum, each parametrized by the arclength
+        // along the tangent of its first point.
+        for (std::size_t from : {idx[m - 1], i}) {
+          const std::size_t to = from == i ? idx[m + 1] : i;
+          const continuation::BranchPoint& p = out.points[from];
+          const double length = p.tangent.dot(sys.to_scaled(out.points[to].x, out.points[to].lambda) -
+                                              sys.to_scaled(p.x, p.lambda));
+          if (!(length > 0)) continue;
+          const continuation::Extremum e = continuation::locate_maximum(equations, ao, p, length, amplitude);
+          out.summary.residual_evaluations += e.evaluations;
+          if (e.found && e.value > peak.amplitude_m) {
+            peak.amplitude_m = e.value;
+            peak.frequency_hz = e.lambda;
+            peak.located = true;
+          } else if (e.found) {
+            peak.located = true;  // the sampled point is the maximum to tolerance
+          }
+        }
+      }
+      out.peaks.push_back(peak);
+    }
+  }
+  std::sort(out.peaks.begin(), out.peaks.end(),
+            [](const ResponsePeak& a, const ResponsePeak& b) { return a.frequency_hz < b.frequency_hz; });
+  out.peak_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace shroudsim::forced

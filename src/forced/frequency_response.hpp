@@ -1,0 +1,107 @@
+#pragma once
+// The nonlinear frequency response of a forced model (docs/continuation.md, "Frequency
+// response"): the continuation's units taken from the problem, the start search, the branch
+// traced over the range (completed from the far end when it cannot get through, accepted only
+// when the two pieces provably join), the resonance peaks located to solver tolerance, and
+// every point analysed. The commands (`frf`, `study`) and the benchmarks call this; they only
+// map a case onto it and write what it returns.
+//
+// Units (so that a model rescaled in time, M -> s^2 M, C -> s C, f -> f / s, gives the same
+// curve with the same settings):
+//   lambda unit  = |f_end - f_start| / 100             (the range spans 100 units)
+//   x unit       = (largest free contact motion over the range, sampled on 41 points and at
+//                   every natural frequency of the linear part inside it) / 20
+//   initial step = 0.25 units ("auto"), or the Hz-equivalent initial_step_hz / lambda unit,
+//                  and never above the largest step, 0.5 units: at least 200 points span the
+//                  range.
+#include <Eigen/Core>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "contact/contact_law.hpp"
+#include "continuation/arclength.hpp"
+#include "forced/reduced_equations.hpp"
+#include "frf/linear_part.hpp"
+#include "hbm/contact_evaluator.hpp"
+
+namespace shroudsim::forced {
+
+/// A linear part and the parameters of its contact pairs, in the same order.
+struct ForcedModel {
+  std::unique_ptr<frf::LinearPart> linear;
+  std::vector<contact::PairParameters> pairs;
+};
+
+struct FrequencyResponseSettings {
+  double frequency_start_hz = 100.0;
+  double frequency_end_hz = 220.0;
+  double initial_step_hz = 0.0;  ///< Hz-equivalent arclength; <= 0: "auto" (0.25 units)
+  int max_points = 5000;
+  double tolerance = 1e-8;       ///< Newton tolerance on the scaled residual
+  bool locate_peaks = true;
+};
+
+/// The range spans this many units of lambda; the free peak this many units of x.
+constexpr double kRangeUnits = 100.0;
+constexpr double kFreePeakUnits = 20.0;
+constexpr double kAutoInitialStep = 0.25;  ///< units
+constexpr double kMaxStep = 0.5;           ///< units: at least kRangeUnits / kMaxStep points
+
+/// The largest free contact motion over the range (41 samples and every resonance inside).
+double free_motion_peak(const frf::LinearPart& linear, const ReducedEquations& equations, double f_start, double f_end);
+
+/// The continuation options of a forced response (units above).
+continuation::ArclengthOptions arclength_options(const FrequencyResponseSettings& settings, const ForcedModel& model,
+                                                 const ReducedEquations& equations);
+
+/// A solution of `equations` at frequency f: Newton from the stuck-contact solution; where it
+/// fails (Newton cycling between contact states), from the free response, then harmonic
+/// stepping (H = 1, then one harmonic at a time, each new one from zero), then continuation in
+/// the excitation level from the preload-only state. When all of these fail at f, the same
+/// search a little way off (f (1 +- 0.002, 0.005, 0.01)), then Newton at fixed frequencies
+/// back to f. `how` names the method that worked. Throws NumericalError when none does.
+Eigen::VectorXd find_start(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                           ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
+                           std::string& how);
+
+/// A resonance peak: a local maximum of the response amplitude along the branch.
+struct ResponsePeak {
+  double frequency_hz = 0.0;
+  double amplitude_m = 0.0;
+  std::size_t point = 0;   ///< the sampled point nearest to it (index into points)
+  int piece = 0;
+  bool located = false;    ///< located to solver tolerance (false: the sampled maximum)
+};
+
+struct FrequencyResponse {
+  std::vector<continuation::BranchPoint> points;  ///< every point, piece after piece
+  std::vector<int> piece;                         ///< of each point (0, or 1 traced back from the end)
+  std::vector<PointResult> results;               ///< analyse() of each point
+  std::vector<ResponsePeak> peaks;                ///< by frequency
+  continuation::Branch summary;                   ///< status, message and counts of all pieces (no points)
+  continuation::ArclengthOptions options;         ///< as traced (units included)
+  std::string start, start_second_piece;          ///< how the start points were found
+  bool two_pieces = false;
+  bool pieces_join = true;
+  double join_distance = 0.0;                     ///< scaled distance at the join check
+  std::vector<std::string> warnings;
+  double peak_seconds = 0.0;                      ///< time spent locating peaks
+};
+
+/// The forced response over the range. progress is called for every point that stays on the
+/// curve (piece 0, then piece 1 once it is known to join). Throws NumericalError when no start
+/// is found; any other failure is in summary.status / summary.message with what was traced.
+FrequencyResponse trace_frequency_response(
+    const FrequencyResponseSettings& settings, const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+    ReducedEquations& equations,
+    const std::function<void(const continuation::BranchPoint&, int piece)>& progress = {},
+    const std::function<void(const std::string&)>& info = {});
+
+/// The local maxima of a sequence of amplitudes that stand out: prominence (the drop to the
+/// higher of the two lowest points before a higher one, or the curve's end, on each side) at
+/// least `min_prominence` times the peak's height. Indices, in order.
+std::vector<std::size_t> prominent_maxima(const std::vector<double>& a, double min_prominence);
+
+}  // namespace shroudsim::forced

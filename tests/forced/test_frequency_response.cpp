@@ -1,0 +1,214 @@
+// The frequency response as the commands trace it (forced/frequency_response.hpp): invariance
+// under a rescaling of time, the default settings on a small chain against a fine reference,
+// resonance peaks located independently of the step, and the same curve whatever the thread
+// count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include "forced/frequency_response.hpp"
+#include "frf/lumped.hpp"
+
+namespace shroudsim::forced {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+/// A lumped model with its contact pairs and the evaluator options it is traced with.
+struct Lumped {
+  ForcedModel model;
+  hbm::ContactEvaluatorOptions options;
+  double f_start = 0.0, f_end = 0.0;
+};
+
+/// The 2-DOF chain: M = s^2 I, K = [[2, -1], [-1, 2]], C = 0.02 s K, a Jenkins element on
+/// DOF 0 (kt = 1, mu N0 = 1.5), 1 N on DOF 0, 0.8 to 1.4 rad/s (divided by s). s rescales
+/// time: every curve is the same with frequencies divided by s.
+Lumped chain(double s, int h = 7, int n = 256) {
+  Lumped l;
+  Eigen::MatrixXd k(2, 2);
+  k << 2, -1, -1, 2;
+  frf::LumpedContact c;
+  c.dof = {0, -1, -1};
+  l.model.linear = std::make_unique<frf::LumpedLinearPart>(s * s * Eigen::MatrixXd::Identity(2, 2), k, 0.02 * s * k,
+                                                           std::vector<frf::LumpedContact>{c}, 0, 1.0, 0);
+  contact::PairParameters p;
+  p.tangential_stiffness = 1.0;
+  p.normal_stiffness = 1.0;
+  p.friction_coefficient = 1.5;
+  p.normal_preload = 1.0;
+  l.model.pairs = {p};
+  l.options.n_harmonics = h;
+  l.options.n_time_samples = n;
+  l.options.law.model = contact::Model::one_d;
+  l.options.threads = 1;
+  l.options.measure_plans = false;
+  l.f_start = 0.8 / (2 * kPi * s);
+  l.f_end = 1.4 / (2 * kPi * s);
+  return l;
+}
+
+/// A point mass (x, y, z; 10 Hz, 1 kg, 1 % damping; time rescaled by s) on a full3d contact
+/// to ground with preload: stick, slip and separation over the period near resonance.
+Lumped mass_on_full3d(double s) {
+  Lumped l;
+  const double k0 = std::pow(2 * kPi * 10.0, 2);
+  const Eigen::MatrixXd id = Eigen::MatrixXd::Identity(3, 3);
+  frf::LumpedContact c;
+  c.dof = {0, 1, 2};
+  c.frame_angle = 0.3;
+  l.model.linear = std::make_unique<frf::LumpedLinearPart>(s * s * id, k0 * id, s * 2 * 0.01 * std::sqrt(k0) * id,
+                                                           std::vector<frf::LumpedContact>{c}, 0, 1.0, 0);
+  contact::PairParameters p;
+  p.tangential_stiffness = k0;
+  p.normal_stiffness = k0;
+  p.friction_coefficient = 0.3;
+  p.normal_preload = 1.0;
+  l.model.pairs = {p};
+  l.options.n_harmonics = 5;
+  l.options.n_time_samples = 128;
+  l.options.law.model = contact::Model::full3d;
+  l.options.threads = 1;
+  l.options.measure_plans = false;
+  l.f_start = 5.0 / s;
+  l.f_end = 25.0 / s;
+  return l;
+}
+
+FrequencyResponse trace(Lumped& l, double initial_step_hz = 0.0) {
+  hbm::ContactEvaluator ev(l.options, l.model.pairs);
+  ReducedEquations eq(*l.model.linear, ev);
+  FrequencyResponseSettings s;  // the defaults of the case file
+  s.frequency_start_hz = l.f_start;
+  s.frequency_end_hz = l.f_end;
+  s.initial_step_hz = initial_step_hz;
+  return trace_frequency_response(s, l.model, l.options, eq);
+}
+
+const ResponsePeak& largest(const FrequencyResponse& r) {
+  const ResponsePeak* best = &r.peaks.front();
+  for (const auto& p : r.peaks)
+    if (p.amplitude_m > best->amplitude_m) best = &p;
+  return *best;
+}
+
+// Two curves whose scaled equations agree to round-off: the located peaks agree to the
+// corrector's tolerance (1e-8 on residuals of the size of the x unit, 1/20 of the free peak).
+constexpr double kPeakTol = 1e-6;
+
+void expect_time_rescaling_invariance(Lumped (*make)(double)) {
+  std::vector<FrequencyResponse> r;
+  const std::vector<double> scales = {1e-3, 1.0, 1e3};
+  for (double s : scales) {
+    Lumped l = make(s);
+    r.push_back(trace(l));
+    ASSERT_EQ(r.back().summary.status, continuation::BranchStatus::kReachedEnd) << "s = " << s << ": " << r.back().summary.message;
+    ASSERT_FALSE(r.back().peaks.empty());
+  }
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    EXPECT_EQ(r[i].points.size(), r[1].points.size()) << "s = " << scales[i];
+    EXPECT_EQ(r[i].peaks.size(), r[1].peaks.size()) << "s = " << scales[i];
+    const ResponsePeak &a = largest(r[i]), &b = largest(r[1]);
+    EXPECT_TRUE(a.located);
+    EXPECT_NEAR(a.amplitude_m, b.amplitude_m, kPeakTol * b.amplitude_m) << "s = " << scales[i];
+    EXPECT_NEAR(a.frequency_hz * scales[i], b.frequency_hz, kPeakTol * b.frequency_hz) << "s = " << scales[i];
+  }
+}
+
+TEST(FrequencyResponse, TimeRescalingGivesTheSameCurveOneDimensionalJenkinsChain) {
+  expect_time_rescaling_invariance(+[](double s) { return chain(s); });
+}
+
+TEST(FrequencyResponse, TimeRescalingGivesTheSameCurveFullThreeDimensionalContact) {
+  expect_time_rescaling_invariance(&mass_on_full3d);
+}
+
+TEST(FrequencyResponse, TwoDofChainWithDefaultSettingsMatchesAFineReference) {
+  Lumped l = chain(1.0);
+  const FrequencyResponse r = trace(l);
+  ASSERT_EQ(r.summary.status, continuation::BranchStatus::kReachedEnd) << r.summary.message;
+  EXPECT_FALSE(r.two_pieces);
+  // Reference: H = 25, N = 2048 (converged in H and N to ~1e-5 on this curve).
+  Lumped fine = chain(1.0, 25, 2048);
+  const FrequencyResponse ref = trace(fine);
+  ASSERT_EQ(ref.summary.status, continuation::BranchStatus::kReachedEnd) << ref.summary.message;
+  // The goal: the peak within 2e-3 of a fine reference (H = 7 truncates the
+  // harmonics; measured 8e-5).
+  constexpr double kReferenceTol = 2e-3;
+  EXPECT_NEAR(largest(r).amplitude_m, largest(ref).amplitude_m, kReferenceTol * largest(ref).amplitude_m);
+  EXPECT_NEAR(largest(r).frequency_hz, largest(ref).frequency_hz, kReferenceTol * largest(ref).frequency_hz);
+}
+
+TEST(FrequencyResponse, PeakLocationDoesNotDependOnTheStep) {
+  std::vector<ResponsePeak> peaks;
+  for (double step_hz : {0.0, 2e-5, 1e-4}) {  // auto (0.25 units = 2.4e-4 Hz), and two smaller
+    Lumped l = chain(1.0);
+    const FrequencyResponse r = trace(l, step_hz);
+    ASSERT_EQ(r.summary.status, continuation::BranchStatus::kReachedEnd) << r.summary.message;
+    peaks.push_back(largest(r));
+    EXPECT_TRUE(peaks.back().located);
+  }
+  for (const auto& p : peaks) {
+    EXPECT_NEAR(p.amplitude_m, peaks[0].amplitude_m, kPeakTol * peaks[0].amplitude_m);
+    EXPECT_NEAR(p.frequency_hz, peaks[0].frequency_hz, kPeakTol * peaks[0].frequency_hz);
+  }
+}
+
+TEST(FrequencyResponse, TheSameCurveBitForBitWhateverTheThreadCount) {
+  // Three masses in a chain, each on a full3d contact; the GMRES path of the bordered solves
+  // (forced) as well as the dense one.
+  for (auto kind : {LinearSolverOptions::Kind::dense, LinearSolverOptions::Kind::krylov}) {
+    std::vector<FrequencyResponse> r;
+    for (int threads : {1, 2}) {
+      Lumped l;
+      const int n = 9;
+      const double k0 = std::pow(2 * kPi * 8.0, 2);
+      Eigen::MatrixXd k = Eigen::MatrixXd::Zero(n, n);
+      for (int node = 0; node < 3; ++node)
+        for (int d = 0; d < 3; ++d) {
+          const int i = 3 * node + d;
+          k(i, i) += k0 * (1.0 + 0.3 * d);
+          if (node < 2) k(i, i) += 2 * k0, k(i + 3, i + 3) += 2 * k0, k(i, i + 3) -= 2 * k0, k(i + 3, i) -= 2 * k0;
+        }
+      std::vector<frf::LumpedContact> contacts;
+      for (int node = 0; node < 3; ++node) {
+        frf::LumpedContact c;
+        c.dof = {3 * node, 3 * node + 1, 3 * node + 2};
+        c.frame_angle = 0.2 * node;
+        contacts.push_back(c);
+        contact::PairParameters p;
+        p.tangential_stiffness = 2000.0 * (1 + node);
+        p.normal_stiffness = 3000.0;
+        p.friction_coefficient = 0.3;
+        p.normal_preload = 0.5;
+        l.model.pairs.push_back(p);
+      }
+      l.model.linear = std::make_unique<frf::LumpedLinearPart>(Eigen::MatrixXd::Identity(n, n), k, 1e-3 * k, contacts, 0,
+                                                               1.0, 3);
+      l.options.n_harmonics = 3;
+      l.options.n_time_samples = 64;
+      l.options.law.model = contact::Model::full3d;
+      l.options.threads = threads;
+      l.options.measure_plans = false;
+      hbm::ContactEvaluator ev(l.options, l.model.pairs);
+      ReducedEquations eq(*l.model.linear, ev);
+      LinearSolverOptions so;
+      so.kind = kind;
+      eq.set_linear_solver(so);
+      FrequencyResponseSettings s;
+      s.frequency_start_hz = 6.0;
+      s.frequency_end_hz = 12.0;
+      r.push_back(trace_frequency_response(s, l.model, l.options, eq));
+    }
+    ASSERT_EQ(r[0].points.size(), r[1].points.size());
+    for (std::size_t i = 0; i < r[0].points.size(); ++i) {
+      ASSERT_EQ(r[0].points[i].lambda, r[1].points[i].lambda) << i;
+      ASSERT_TRUE(r[0].points[i].x == r[1].points[i].x) << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace shroudsim::forced
