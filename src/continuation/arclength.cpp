@@ -210,6 +210,7 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
         if (inside) {
           push(fold.y, fold.t, fold.newton_iterations, fold.s, 0.0, fold.smooth ? PointKind::kFold : PointKind::kCorner);
           h = std::max(h - fold.s, 0.0);
+          if (static_cast<int>(branch.points.size()) >= o.max_points) break;  // the fold took the last place
         }
       }
       watch.arm(branch.points.size() - (branch.points.back().kind == PointKind::kRegular ? 0 : 1));

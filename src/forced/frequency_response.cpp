@@ -238,29 +238,50 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
       const continuation::Branch second = continuation::trace(equations, back_start, back);
       add_counts(out.summary, second);
       // The join check.
-      bool joined = false;
-      out.join_distance = std::numeric_limits<double>::infinity();
-      if (!second.points.empty()) {
-        out.join_distance = continuation::distance_to_branch(equations, ao, first.points, second.points.back());
-        // Two solutions of the same equations to tolerance agree far within a step.
-        joined = out.join_distance <= kJoinTolerance;
-      }
-      out.pieces_join = joined;
-      if (!joined) {
-        out.summary.status = continuation::BranchStatus::kEvaluationFailed;
-        out.summary.message = first_message + "; the branch traced back from " + number(ao.lambda_end) +
-                              " Hz does not join it (scaled distance " + number(out.join_distance) +
-                              "): two separate branches, the range is not covered by one";
-      } else if (second.status == continuation::BranchStatus::kReachedEnd) {
+      // How far towards the start the second piece got.
+      double reached_back = ao.lambda_end;
+      for (const auto& p : second.points)
+        reached_back = direction > 0 ? std::min(reached_back, p.lambda) : std::max(reached_back, p.lambda);
+      const bool covered = direction * (reached_back - reached) <= 0;
+      if (second.status == continuation::BranchStatus::kLeftRange && covered) {
+        // Both pieces turned back, but between them every frequency of the range has a
+        // solution: reported as two separate branches.
+        out.pieces_join = false;
         out.summary.status = continuation::BranchStatus::kReachedEnd;
         out.summary.message = "";
-        out.warnings.push_back("the curve is in two pieces: the branch from " + number(ao.lambda_start) +
-                               " Hz stopped at " + number(reached) + " Hz (" + first_message +
-                               "); the rest was traced back from " + number(ao.lambda_end) +
-                               " Hz and joins it (frf.csv column `piece`)");
-      } else {
+        out.warnings.push_back("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
+                               " Hz turned back at " + number(reached) + " Hz (" + first_message +
+                               "), the branch traced back from " + number(ao.lambda_end) + " Hz turned back at " +
+                               number(reached_back) +
+                               " Hz; together they cover the range, but they were not shown to be one branch "
+                               "(frf.csv column `piece`)");
+      } else if (second.status != continuation::BranchStatus::kReachedEnd) {
+        out.pieces_join = false;
         out.summary.message = first_message + "; tracing back from " + number(ao.lambda_end) + " Hz stopped too: " +
                               second.message;
+      } else {
+        out.join_distance = continuation::distance_to_branch(equations, ao, first.points, second.points.back());
+        // Two solutions of the same equations to tolerance agree far within a step.
+        out.pieces_join = out.join_distance <= kJoinTolerance;
+        if (out.pieces_join) {
+          out.summary.status = continuation::BranchStatus::kReachedEnd;
+          out.summary.message = "";
+          out.warnings.push_back("the curve is in two pieces: the branch from " + number(ao.lambda_start) +
+                                 " Hz stopped at " + number(reached) + " Hz (" + first_message +
+                                 "); the rest was traced back from " + number(ao.lambda_end) +
+                                 " Hz and joins it (frf.csv column `piece`)");
+        } else {
+          // Both pieces are solutions to tolerance and together they cover the range, but
+          // they were not shown to be one branch (typically the two stable sides of a fold
+          // pair, the unstable branch between them left untraced): reported as two branches.
+          out.summary.status = continuation::BranchStatus::kReachedEnd;
+          out.summary.message = "";
+          out.warnings.push_back("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
+                                 " Hz stopped at " + number(reached) + " Hz (" + first_message +
+                                 "); the branch traced back from " + number(ao.lambda_end) +
+                                 " Hz covers the rest but does not join it (scaled distance " +
+                                 number(out.join_distance) + "; frf.csv column `piece`)");
+        }
       }
       for (const auto& p : second.points) {
         out.points.push_back(p);
