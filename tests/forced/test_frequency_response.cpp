@@ -10,6 +10,7 @@
 
 #include "forced/frequency_response.hpp"
 #include "frf/lumped.hpp"
+#include "three_contacts.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -163,30 +164,8 @@ TEST(FrequencyResponse, TheSameCurveBitForBitWhateverTheThreadCount) {
     std::vector<FrequencyResponse> r;
     for (int threads : {1, 2}) {
       Lumped l;
-      const int n = 9;
-      const double k0 = std::pow(2 * kPi * 8.0, 2);
-      Eigen::MatrixXd k = Eigen::MatrixXd::Zero(n, n);
-      for (int node = 0; node < 3; ++node)
-        for (int d = 0; d < 3; ++d) {
-          const int i = 3 * node + d;
-          k(i, i) += k0 * (1.0 + 0.3 * d);
-          if (node < 2) k(i, i) += 2 * k0, k(i + 3, i + 3) += 2 * k0, k(i, i + 3) -= 2 * k0, k(i + 3, i) -= 2 * k0;
-        }
-      std::vector<frf::LumpedContact> contacts;
-      for (int node = 0; node < 3; ++node) {
-        frf::LumpedContact c;
-        c.dof = {3 * node, 3 * node + 1, 3 * node + 2};
-        c.frame_angle = 0.2 * node;
-        contacts.push_back(c);
-        contact::PairParameters p;
-        p.tangential_stiffness = 2000.0 * (1 + node);
-        p.normal_stiffness = 3000.0;
-        p.friction_coefficient = 0.3;
-        p.normal_preload = 0.5;
-        l.model.pairs.push_back(p);
-      }
-      l.model.linear = std::make_unique<frf::LumpedLinearPart>(Eigen::MatrixXd::Identity(n, n), k, 1e-3 * k, contacts, 0,
-                                                               1.0, 3);
+      l.model.linear = std::make_unique<frf::LumpedLinearPart>(testing::three_contacts_linear());
+      l.model.pairs = testing::three_contacts_pairs();
       l.options.n_harmonics = 3;
       l.options.n_time_samples = 64;
       l.options.law.model = contact::Model::full3d;

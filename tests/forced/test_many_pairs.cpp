@@ -17,6 +17,7 @@
 #include "fe/assembly.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/lumped.hpp"
+#include "three_contacts.hpp"
 #include "frf/sector.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "mesh/msh_reader.hpp"
@@ -31,45 +32,10 @@ constexpr double kPi = std::numbers::pi;
 // structured product only reorders the same sums.
 constexpr double kRoundOff = 1e-12;
 
-/// Three point masses (x, y, z each: 9 DOFs) on springs to ground and to each other, modes
-/// near 8 to 30 Hz, 1 % stiffness-proportional damping, each mass with a full3d contact to
-/// ground; 1 N on DOF 0.
+/// The shared three-contact model (three_contacts.hpp).
 struct ThreeContacts {
-  frf::LumpedLinearPart linear;
-  std::vector<contact::PairParameters> pairs;
-
-  static frf::LumpedLinearPart make() {
-    const int n = 9;
-    Eigen::MatrixXd m = Eigen::MatrixXd::Identity(n, n), k = Eigen::MatrixXd::Zero(n, n);
-    const double k0 = std::pow(2 * kPi * 8.0, 2);
-    for (int node = 0; node < 3; ++node)
-      for (int d = 0; d < 3; ++d) {
-        const int i = 3 * node + d;
-        k(i, i) += k0 * (1.0 + 0.3 * d);
-        if (node < 2) {  // spring to the next mass, same direction
-          const int j = i + 3;
-          k(i, i) += 2 * k0, k(j, j) += 2 * k0, k(i, j) -= 2 * k0, k(j, i) -= 2 * k0;
-        }
-      }
-    std::vector<frf::LumpedContact> contacts;
-    for (int node = 0; node < 3; ++node) {
-      frf::LumpedContact c;
-      c.dof = {3 * node, 3 * node + 1, 3 * node + 2};
-      c.frame_angle = 0.2 * node;
-      contacts.push_back(c);
-    }
-    return frf::LumpedLinearPart(m, k, 1e-3 * k, contacts, 0, 1.0, 3);
-  }
-  ThreeContacts() : linear(make()) {
-    for (int i = 0; i < 3; ++i) {
-      contact::PairParameters p;
-      p.tangential_stiffness = 2000.0 * (1 + i);
-      p.normal_stiffness = 3000.0;
-      p.friction_coefficient = 0.3;
-      p.normal_preload = 0.5;
-      pairs.push_back(p);
-    }
-  }
+  frf::LumpedLinearPart linear = testing::three_contacts_linear();
+  std::vector<contact::PairParameters> pairs = testing::three_contacts_pairs();
 };
 
 hbm::ContactEvaluatorOptions evaluator_options(int h) {
