@@ -532,6 +532,9 @@ void read_all(Reader& r, Case& c) {
   h.tolerance = r.number("hbm.tolerance", [](double v) -> std::optional<std::string> {
     return v > 0 && v < 1 ? std::nullopt : std::optional<std::string>("0 < tolerance < 1");
   });
+  h.energy_tolerance = r.number("hbm.energy_tolerance", [](double v) -> std::optional<std::string> {
+    return v > 0 && v <= 1 ? std::nullopt : std::optional<std::string>("0 < energy_tolerance <= 1");
+  });
   h.auto_tolerance = r.number("hbm.auto_tolerance", [](double v) -> std::optional<std::string> {
     return v > 0 && v < 1 ? std::nullopt : std::optional<std::string>("0 < auto_tolerance < 1");
   });

@@ -99,6 +99,7 @@ struct HbmSection {
   bool time_samples_auto = false;
   std::string jacobian = "analytic";     ///< or "finite_difference"
   double tolerance = 1e-8;
+  double energy_tolerance = 1e-3;        ///< energy-balance error above which a point fails the run
   double auto_tolerance = 0.01;          ///< "auto": relative change of the peak amplitude to stop at
   int auto_max_harmonics = 25;           ///< "auto": largest H tried
   int auto_max_time_samples = 4096;      ///< "auto": largest N tried

@@ -86,6 +86,7 @@ const std::vector<KeySpec>& case_schema() {
       {"hbm.time_samples", "512", "N >= 2H+1, <= 65536, or \"auto\"", "N: time samples per period"},
       {"hbm.jacobian", "\"analytic\"", "\"analytic\" | \"finite_difference\" | \"finite_difference_full\"", "Jacobian of the contact forces (finite_difference: per pair; _full: the whole force vector, for comparison only)"},
       {"hbm.tolerance", "1e-8", "0 < tol < 1", "Newton tolerance on the scaled residual"},
+      {"hbm.energy_tolerance", "0.001", "0 < tol <= 1", "largest energy-balance error (|excitation work - dissipation| per cycle, relative) of a point before the run counts as failed numerics (exit 3)"},
       {"hbm.auto_tolerance", "0.01", "0 < tol < 1", "\"auto\" H or N: stop when the peak amplitude changes by less (relative)"},
       {"hbm.auto_max_harmonics", "25", "1 <= H <= 200", "\"auto\" harmonics: largest H tried"},
       {"hbm.auto_max_time_samples", "4096", "16 <= N <= 65536", "\"auto\" time samples: largest N tried"},

@@ -57,5 +57,55 @@ TEST(CliContinuation, TimeRescaledSectorGivesTheSamePeakAndAnyThreadCountTheSame
   }
 }
 
+TEST(CliContinuation, ACurveThatFailsItsEnergyBalanceIsNotReportedAsSuccess) {
+  // A stress-corpus model (tools/stress_continuation.py, seed 1, model 74: 3 DOFs, a very
+  // stiff stuck 1d contact, N = 64) whose points converge in the residual but not in the
+  // energy balance (error 0.14 of the excitation work per cycle).
+  const Scratch s("energy");
+  s.write("case.toml", R"(name = "stress_0074"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[0.03840514117196052, 0.0, 0.0], [0.0, 0.03154466528782106, 0.0], [0.0, 0.0, 0.1029848885039463]]
+stiffness = [[85796730.74564694, -45960403.407765195, 0.0], [-45960403.407765195, 63584727.87830496, -17624324.470539767], [0.0, -17624324.470539767, 45594290.19558298]]
+damping = [[0.6201114417970204, -0.22569507098599897, 0.0], [-0.22569507098599897, 0.4755247474285935, -0.08654674170650771], [0.0, -0.08654674170650771, 0.7569722956509034]]
+
+[excitation]
+force = 0.6563521410889713
+dof = 0
+
+[response]
+dof = 2
+
+[contact]
+model = "1d"
+friction_coefficient = 0.7030690948118106
+tangential_stiffness = 12694115164.065872
+normal_stiffness = 20402611548.839394
+normal_preload = 2.7319310870975975
+
+[[contact.elements]]
+x_dof = 0
+
+[hbm]
+harmonics = 4
+time_samples = 64
+
+[continuation]
+frequency_start_hz = 2011.6141859588283
+frequency_end_hz = 3913.0516074698676
+)");
+  const CliResult bad = s.run("frf case.toml --quiet");
+  EXPECT_EQ(bad.status, 3) << bad.err;
+  EXPECT_NE(bad.err.find("hbm.energy_tolerance"), std::string::npos) << bad.err;
+  const auto frf = frf_of(s, "results/stress_0074");
+  EXPECT_FALSE(frf["energy_check_passed"].get<bool>());
+  EXPECT_GT(frf["max_energy_balance_error"].get<double>(), 1e-3);
+  // The check relaxed on purpose: the same curve, status ok.
+  const CliResult relaxed = s.run("frf case.toml --quiet --set hbm.energy_tolerance=1");
+  EXPECT_EQ(relaxed.status, 0) << relaxed.err;
+}
+
 }  // namespace
 }  // namespace shroudsim::testing
