@@ -368,6 +368,7 @@ int cmd_frf(Context& ctx) {
     if (r.energy_error == max_energy_error) worst_energy_f = r.frequency_hz;
   const bool energy_failed = max_energy_error > c.hbm.energy_tolerance;
   j["energy_check_passed"] = !energy_failed;
+  j["polished_points"] = response.polished_points;
   std::ostringstream s;
   s << "frf: " << kept.size() << " points, peak " << std::scientific << std::setprecision(4) << peak << " m at "
     << std::defaultfloat << std::setprecision(6) << peak_f << " Hz, " << branch.turning_points << " turning points, "

@@ -88,6 +88,7 @@ struct FrequencyResponse {
   double join_distance = 0.0;                     ///< scaled distance at the join check
   std::vector<std::string> warnings;
   double peak_seconds = 0.0;                      ///< time spent locating peaks
+  int polished_points = 0;                        ///< points re-solved at their own scale for the energy balance
 };
 
 /// The forced response over the range. progress is called for every point that stays on the
