@@ -263,8 +263,7 @@ int cmd_frf(Context& ctx) {
       frequency_response_settings(c), model, eo, equations, progress, [](const std::string& s) { log::info(s); });
   const continuation::Branch& branch = response.summary;
   const continuation::ArclengthOptions& ao = response.options;
-  const std::vector<forced::PointResult>& kept = response.results;
-  const std::vector<int>& kept_piece = response.piece;
+  const std::vector<forced::PointResult>& results = response.results;
   ctx.report.section("frf")["start"] = response.start;
   if (response.two_pieces) ctx.report.section("frf")["start_second_piece"] = response.start_second_piece;
   for (const auto& w : response.warnings) ctx.report.warn(w);
@@ -276,19 +275,19 @@ int cmd_frf(Context& ctx) {
   double max_energy_error = 0.0, peak = 0.0, peak_f = 0.0;
   std::size_t peak_index = 0;
   int unconverged = 0;
-  for (std::size_t i = 0; i < kept.size(); ++i) {
-    const auto& r = kept[i];
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
     csv << io::format_number(r.frequency_hz) << "," << io::format_number(r.amplitude) << ","
         << io::format_number(r.linear_amplitude) << "," << response.points[i].newton_iterations;
     for (double a : r.harmonic_amplitudes) csv << "," << io::format_number(a);
-    csv << "," << kept_piece[i] << "\n";
+    csv << "," << response.piece[i] << "\n";
     max_energy_error = std::max(max_energy_error, r.energy_error);
     unconverged += r.unconverged_pairs;
-    if (r.amplitude > peak) peak_index = i;
+    if (r.amplitude > results[peak_index].amplitude) peak_index = i;
   }
   // The reported peak: the largest located resonance peak (the largest sampled point if none).
-  peak = kept.empty() ? 0.0 : kept[peak_index].amplitude;
-  peak_f = kept.empty() ? 0.0 : kept[peak_index].frequency_hz;
+  peak = results.empty() ? 0.0 : results[peak_index].amplitude;
+  peak_f = results.empty() ? 0.0 : results[peak_index].frequency_hz;
   for (const auto& pk : response.peaks)
     if (pk.amplitude_m >= peak) peak = pk.amplitude_m, peak_f = pk.frequency_hz, peak_index = pk.point;
   io::write_file_atomic(ctx.out_dir / "frf.csv", csv.str());
@@ -313,8 +312,8 @@ int cmd_frf(Context& ctx) {
   }
 
   auto& j = ctx.report.section("frf");
-  j["points"] = kept.size();
-  j["pieces"] = kept_piece.empty() ? 0 : kept_piece.back() + 1;
+  j["points"] = results.size();
+  j["pieces"] = response.piece.empty() ? 0 : response.piece.back() + 1;
   j["status"] = continuation::to_string(branch.status);
   j["message"] = branch.message;
   j["turning_points"] = branch.turning_points;
@@ -364,13 +363,13 @@ int cmd_frf(Context& ctx) {
   // mechanics, whatever the residual says (e.g. a contact law that did not reach its periodic
   // state): the run fails its own check (docs/continuation.md).
   double worst_energy_f = 0.0;
-  for (const auto& r : kept)
+  for (const auto& r : results)
     if (r.energy_error == max_energy_error) worst_energy_f = r.frequency_hz;
   const bool energy_failed = max_energy_error > c.hbm.energy_tolerance;
   j["energy_check_passed"] = !energy_failed;
   j["polished_points"] = response.polished_points;
   std::ostringstream s;
-  s << "frf: " << kept.size() << " points, peak " << std::scientific << std::setprecision(4) << peak << " m at "
+  s << "frf: " << results.size() << " points, peak " << std::scientific << std::setprecision(4) << peak << " m at "
     << std::defaultfloat << std::setprecision(6) << peak_f << " Hz, " << branch.turning_points << " turning points, "
     << branch.newton_iterations << " Newton iterations, max energy-balance error " << std::setprecision(2)
     << max_energy_error;
@@ -383,11 +382,11 @@ int cmd_frf(Context& ctx) {
                          io::format_number(c.hbm.energy_tolerance) +
                          " (excitation work and dissipation per cycle disagree: raise hbm.time_samples, or relax "
                          "hbm.energy_tolerance to accept the curve; " +
-                         std::to_string(kept.size()) + " points written to frf.csv)");
+                         std::to_string(results.size()) + " points written to frf.csv)");
   }
   if (branch.status != continuation::BranchStatus::kReachedEnd) {
     ctx.report.section("frf")["failed"] = true;
-    throw NumericalError("continuation stopped: " + branch.message + " (" + std::to_string(kept.size()) +
+    throw NumericalError("continuation stopped: " + branch.message + " (" + std::to_string(results.size()) +
                          " points written to frf.csv)");
   }
   return 0;

@@ -56,8 +56,7 @@ bool ArclengthOptions::validate(int n, std::vector<std::string>* errors) const {
   if (!(lambda_scale > 0 && std::isfinite(lambda_scale))) e.push_back("lambda_scale > 0");
   if (!(start_slack >= 0)) e.push_back("start_slack >= 0");
   if (x_scale.size() && x_scale.size() != n) e.push_back("x_scale of size n = " + std::to_string(n) + " (or empty)");
-  if (x_scale.size() && !(x_scale.array() > 0).all()) e.push_back("x_scale > 0 and finite");
-  if (x_scale.size() && !x_scale.allFinite()) e.push_back("x_scale > 0 and finite");
+  if (x_scale.size() && !((x_scale.array() > 0).all() && x_scale.allFinite())) e.push_back("x_scale > 0 and finite");
   if (residual_scale.size() && residual_scale.size() != n)
     e.push_back("residual_scale of size n = " + std::to_string(n) + " (or empty)");
   if (residual_scale.size() && !((residual_scale.array() > 0).all() && residual_scale.allFinite()))

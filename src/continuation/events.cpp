@@ -124,11 +124,10 @@ Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& op
     const Eigen::VectorXd y_pred = y0 + s * t0;
     Eigen::VectorXd y = y_pred;
     double rnorm = 0.0;
-    ++best.evaluations;
     if (correct(sys, y, t0, y_pred, rnorm) < 0) return std::numeric_limits<double>::infinity();
     const Eigen::VectorXd x = sys.x_of(y);
     const double lambda = sys.lambda_of(y), v = g(x, lambda);
-    if (!best.found || v > best.value) best = Extremum{true, s, x, lambda, v, best.evaluations};
+    if (!best.found || v > best.value) best = Extremum{true, s, x, lambda, v, 0};
     return -v;
   };
   // Brent's minimization of f on [0, step] (golden section with parabolic steps).

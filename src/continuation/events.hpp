@@ -58,7 +58,6 @@ class ReflectionWatch {
   }
   bool active() const { return active_; }
   std::size_t first() const { return first_; }
-  void disarm() { active_ = false; }
   /// A point y (scaled) was accepted after a step `step`; scaled(j) gives accepted point j
   /// and step_to(j) the step that led to it. True when the watch recognises a reflection.
   bool observe(const Eigen::VectorXd& y, double step, const std::function<Eigen::VectorXd(std::size_t)>& scaled,
@@ -81,7 +80,7 @@ struct Extremum {
   Eigen::VectorXd x;
   double lambda = 0.0;
   double value = 0.0;
-  int evaluations = 0;  ///< corrector solves
+  int evaluations = 0;  ///< residual evaluations it took
 };
 Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& options, const BranchPoint& from,
                         double step, const std::function<double(const Eigen::VectorXd&, double)>& g,

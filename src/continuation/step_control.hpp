@@ -14,7 +14,6 @@ class StepControl {
   double step() const { return step_; }
   /// Steps below this are "kink size": a corner of a nonsmooth branch, not a curve to resolve.
   double kink() const { return kink_; }
-  double min() const { return min_; }
   /// After an accepted step: Newton iterations it took and the angle (radians) between the
   /// tangents at its ends. Grows by 1.5 when the corrector took at most half the target
   /// iterations, shrinks by 0.7 above the target, and aims at a turn of the tangent of

@@ -209,7 +209,6 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
   FrequencyResponse out;
   const continuation::ArclengthOptions ao = arclength_options(settings, model, equations);
   out.options = ao;
-  out.start = "";
   const Eigen::VectorXd start = find_start_logged(model, eo, equations, ao, ao.lambda_start, out.start, info);
   continuation::Branch first =
       continuation::trace(equations, start, ao, [&](const continuation::BranchPoint& p) { if (progress) progress(p, 0); });
@@ -220,10 +219,10 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
 
   // A branch that cannot reach the end of the range (it turned back through its start, or
   // stalled at a corner) is completed from the other end: a second piece traced backwards
-  // from frequency_end_hz until it overlaps the first. It is kept only if it provably joins
-  // the first: its last point, inside the first piece's range, lies on the first piece (the
-  // corrector from the nearest point of the first piece, on the hyperplane through it, finds
-  // that very point).
+  // from frequency_end_hz until it overlaps the first. It is one curve with the first only if
+  // it provably joins it: its last point lies on the first piece (continuation::
+  // distance_to_branch). Pieces that do not join but between them cover the range are
+  // reported as two separate branches; otherwise the curve stops where the pieces did.
   const double direction = ao.lambda_end > ao.lambda_start ? 1.0 : -1.0;
   double reached = ao.lambda_start;
   for (const auto& p : first.points) reached = direction > 0 ? std::max(reached, p.lambda) : std::min(reached, p.lambda);
@@ -243,7 +242,12 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
           find_start_logged(model, eo, equations, ao, back.lambda_start, out.start_second_piece, info);
       const continuation::Branch second = continuation::trace(equations, back_start, back);
       add_counts(out.summary, second);
-      // The join check.
+      // The range is covered: the curve reaches the end, with this warning.
+      auto covered_with = [&](const std::string& warning) {
+        out.summary.status = continuation::BranchStatus::kReachedEnd;
+        out.summary.message = "";
+        out.warnings.push_back(warning);
+      };
       // How far towards the start the second piece got.
       double reached_back = ao.lambda_end;
       for (const auto& p : second.points)
@@ -253,14 +257,12 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
         // Both pieces turned back, but between them every frequency of the range has a
         // solution: reported as two separate branches.
         out.pieces_join = false;
-        out.summary.status = continuation::BranchStatus::kReachedEnd;
-        out.summary.message = "";
-        out.warnings.push_back("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
-                               " Hz turned back at " + number(reached) + " Hz (" + first_message +
-                               "), the branch traced back from " + number(ao.lambda_end) + " Hz turned back at " +
-                               number(reached_back) +
-                               " Hz; together they cover the range, but they were not shown to be one branch "
-                               "(frf.csv column `piece`)");
+        covered_with("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
+                     " Hz turned back at " + number(reached) + " Hz (" + first_message +
+                     "), the branch traced back from " + number(ao.lambda_end) + " Hz turned back at " +
+                     number(reached_back) +
+                     " Hz; together they cover the range, but they were not shown to be one branch "
+                     "(frf.csv column `piece`)");
       } else if (second.status != continuation::BranchStatus::kReachedEnd) {
         out.pieces_join = false;
         out.summary.message = first_message + "; tracing back from " + number(ao.lambda_end) + " Hz stopped too: " +
@@ -270,23 +272,17 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
         // Two solutions of the same equations to tolerance agree far within a step.
         out.pieces_join = out.join_distance <= kJoinTolerance;
         if (out.pieces_join) {
-          out.summary.status = continuation::BranchStatus::kReachedEnd;
-          out.summary.message = "";
-          out.warnings.push_back("the curve is in two pieces: the branch from " + number(ao.lambda_start) +
-                                 " Hz stopped at " + number(reached) + " Hz (" + first_message +
-                                 "); the rest was traced back from " + number(ao.lambda_end) +
-                                 " Hz and joins it (frf.csv column `piece`)");
+          covered_with("the curve is in two pieces: the branch from " + number(ao.lambda_start) + " Hz stopped at " +
+                       number(reached) + " Hz (" + first_message + "); the rest was traced back from " +
+                       number(ao.lambda_end) + " Hz and joins it (frf.csv column `piece`)");
         } else {
           // Both pieces are solutions to tolerance and together they cover the range, but
           // they were not shown to be one branch (typically the two stable sides of a fold
           // pair, the unstable branch between them left untraced): reported as two branches.
-          out.summary.status = continuation::BranchStatus::kReachedEnd;
-          out.summary.message = "";
-          out.warnings.push_back("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
-                                 " Hz stopped at " + number(reached) + " Hz (" + first_message +
-                                 "); the branch traced back from " + number(ao.lambda_end) +
-                                 " Hz covers the rest but does not join it (scaled distance " +
-                                 number(out.join_distance) + "; frf.csv column `piece`)");
+          covered_with("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
+                       " Hz stopped at " + number(reached) + " Hz (" + first_message + "); the branch traced back from " +
+                       number(ao.lambda_end) + " Hz covers the rest but does not join it (scaled distance " +
+                       number(out.join_distance) + "; frf.csv column `piece`)");
         }
       }
       for (const auto& p : second.points) {
@@ -348,13 +344,9 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
           if (!(length > 0)) continue;
           const continuation::Extremum e = continuation::locate_maximum(equations, ao, p, length, amplitude);
           out.summary.residual_evaluations += e.evaluations;
-          if (e.found && e.value > peak.amplitude_m) {
-            peak.amplitude_m = e.value;
-            peak.frequency_hz = e.lambda;
-            peak.located = true;
-          } else if (e.found) {
-            peak.located = true;  // the sampled point is the maximum to tolerance
-          }
+          if (!e.found) continue;
+          peak.located = true;  // if no trial point beats the sampled one, it is the maximum to tolerance
+          if (e.value > peak.amplitude_m) peak.amplitude_m = e.value, peak.frequency_hz = e.lambda;
         }
       }
       out.peaks.push_back(peak);

@@ -124,5 +124,26 @@ TEST(CliContinuation, ACurveThatFailsItsEnergyCheckIsNotReportedAsSuccess) {
   EXPECT_EQ(good.status, 0) << good.err;
 }
 
+TEST(CliContinuation, WithoutAResonanceInTheRangeThePeakIsTheLargestPoint) {
+  // The Jenkins oscillator above its 10 Hz resonance, 12 to 20 Hz: the amplitude falls all
+  // the way, so there is no interior peak to locate; the reported one is the largest point
+  // (the first, listed as an end-of-range maximum that was not located).
+  const Scratch s("falling");
+  const CliResult r = s.run("frf " + std::string(SHROUDSIM_SOURCE_DIR) +
+                            "/cases/lumped_jenkins.toml --quiet --out out --set continuation.frequency_start_hz=12"
+                            " --set continuation.frequency_end_hz=20");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto frf = frf_of(s, "out");
+  ASSERT_EQ(frf["peaks"].size(), 1u);
+  EXPECT_FALSE(frf["peaks"][0]["located"].get<bool>());
+  EXPECT_EQ(frf["peak_frequency_hz"].get<double>(), 12.0);
+  std::istringstream csv(slurp(s.dir() / "out" / "frf.csv"));
+  std::string line;
+  std::getline(csv, line);  // header
+  double largest = 0.0;
+  while (std::getline(csv, line)) largest = std::max(largest, std::stod(line.substr(line.find(',') + 1)));
+  EXPECT_EQ(frf["peak_amplitude_m"].get<double>(), largest);
+}
+
 }  // namespace
 }  // namespace shroudsim::testing
