@@ -12,7 +12,7 @@ to-msh
       group "sector";
     - the boundary triangles ("triangle"/"triangle6", outward normals) of the 2D physical
       groups hub, cyclic_low, cyclic_high, shroud_low, shroud_high
-  (../shared/PHYSICS.md section 1; src/mesh/mesh.hpp).
+  (docs/physics.md section 1; src/mesh/mesh.hpp).
 
   Named sets of the input become groups:
     - node sets (Abaqus *NSET, meshio point_sets, 0/1 point-data flags such as the ones

@@ -1,5 +1,5 @@
 #pragma once
-// The `shroudsim` command line (CONTRACT.md). Returns the process exit status:
+// The `shroudsim` command line (docs/contract.md). Returns the process exit status:
 // 0 done, 1 anything else, 2 bad input (usage, case file, mesh), 3 numerics failed.
 namespace shroudsim::app {
 

@@ -1,6 +1,6 @@
 // The FE sector as the forced response sees it: modes of the harmonic indices the engine
 // order reaches, shroud contact pairs with frames and tributary areas, excitation and
-// response nodes (PHYSICS.md sections 2 and 3).
+// response nodes (docs/physics.md sections 2 and 3).
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// Time-discrete friction contact law of one node-to-node pair (PHYSICS.md section 4) and
+// Time-discrete friction contact law of one node-to-node pair (docs/physics.md section 4) and
 // its exact derivative through the time recursion (section 5).
 //
 // Relative displacement samples w(l) = (x, y, z)(l), l = 0..N-1, over one period [m]:
@@ -44,7 +44,7 @@
 
 namespace shroudsim::contact {
 
-/// Contact model (CONTRACT.md [contact] model).
+/// Contact model (docs/contract.md [contact] model).
 enum class Model {
   full3d,      ///< coupled 2D tangential Coulomb, variable normal load, separation
   quasi3d,     ///< x and y as two independent 1D laws, each with limit mu N(l)
@@ -52,7 +52,7 @@ enum class Model {
   one_d_exact  ///< "1d_exact": time-continuous single-harmonic Jenkins solution (H = 1)
 };
 
-/// Tangential update of the coupled law (PHYSICS.md section 4).
+/// Tangential update of the coupled law (docs/physics.md section 4).
 enum class TangentialUpdate {
   radial_return,  ///< trial force, radial return to the circle mu N (the paper's; 1st order in 2D)
   exact_linear    ///< w_t linear within a step, integrated exactly (2nd order in 2D)
@@ -74,7 +74,7 @@ struct PairParameters {
   double normal_preload = 0.25;         ///< N0 [N]; < 0: initial gap -N0/kn (1d models: >= 0)
 
   /// Appends one message per violated constraint ("key = value violates: ...", keys as in
-  /// CONTRACT.md [contact]); returns true when valid.
+  /// docs/contract.md [contact]); returns true when valid.
   bool validate(Model model, std::vector<std::string>* errors) const;
 };
 

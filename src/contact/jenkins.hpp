@@ -2,7 +2,7 @@
 // Time-continuous Jenkins element (spring kt in series with a Coulomb slider of slip force
 // Fs = mu N0) in periodic steady state under one harmonic, x(theta) = c0 + c1 cos(theta) +
 // s1 sin(theta) = c0 + a cos(theta - phi). Reference of the "1d_exact" model and of the tests
-// (PHYSICS.md section 4). Units: m in, N out.
+// (docs/physics.md section 4). Units: m in, N out.
 //
 // With r = Fs/(kt a):
 //   kt a <= Fs (stick):  F = kt x (mean included, as the discrete map started from d = 0);

@@ -1,5 +1,5 @@
 #pragma once
-// Cyclic-symmetry reduction of a sector (../shared/PHYSICS.md section 1).
+// Cyclic-symmetry reduction of a sector (docs/physics.md section 1).
 //
 // Nb sectors, alpha = 2 pi / Nb, R = rotation by +alpha about z. For harmonic index h
 // (0 <= h < Nb) every matched pair (low p, high q = R p) obeys u_q = exp(i h alpha) R u_p.

@@ -1,6 +1,6 @@
 #pragma once
 // The reduced harmonic balance equations on the contact relative displacements
-// (PHYSICS.md section 3), in real arithmetic:
+// (docs/physics.md section 3), in real arithmetic:
 //     r(W, f) = W - W_lin(w) + G(w) F(W) = 0,      J = dr/dW = I + G(w) dF/dW,
 // w = 2 pi f (f in Hz is the continuation parameter). W and F are in the ContactEvaluator
 // layout (pairs one after the other, each [x | y | z] blocks of [c0 | c1 s1 | ... | cH sH]);

@@ -1,5 +1,5 @@
 #pragma once
-// The linear structure as the harmonic balance sees it (PHYSICS.md sections 2 and 3).
+// The linear structure as the harmonic balance sees it (docs/physics.md sections 2 and 3).
 //
 // For temporal harmonic n at circular frequency W = n w [rad/s], with the relative
 // displacement operator B_n of the contact pairs (c = 3 * pairs rows: x, y, z of each pair

@@ -1,5 +1,5 @@
 #pragma once
-// The FE sector as the harmonic balance sees it (PHYSICS.md sections 2 and 3): modal
+// The FE sector as the harmonic balance sees it (docs/physics.md sections 2 and 3): modal
 // receptances of harmonic index h_n = n m mod Nb between the shroud contact pairs, the
 // excitation and the response node, with optional residual flexibility, and the exact
 // static flexibility for n = 0.

@@ -1,6 +1,6 @@
 #pragma once
 // Harmonic balance contact forces of many independent pairs at once, with their
-// block-diagonal Jacobian (PHYSICS.md sections 4-5). The forced-response solver calls
+// block-diagonal Jacobian (docs/physics.md sections 4-5). The forced-response solver calls
 // evaluate() thousands of times per frequency curve: all scratch (time samples, derivative
 // rows, FFTW buffers) and the FFTW plans are made once here and reused; pairs are evaluated
 // in parallel (OpenMP when available), each thread with its own workspace.
@@ -53,7 +53,7 @@ struct ContactEvaluatorOptions {
   int threads = 0;              ///< 0: OpenMP default, 1: serial
   bool measure_plans = true;    ///< FFTW_MEASURE planning
 
-  /// One message per violated constraint, keys named as in CONTRACT.md where they map.
+  /// One message per violated constraint, keys named as in docs/contract.md where they map.
   bool validate(std::vector<std::string>* errors) const;
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// The case file (../shared/CONTRACT.md), parsed and validated: plain data handed to app/,
+// The case file (docs/contract.md), parsed and validated: plain data handed to app/,
 // which maps it onto each stage's own *Options. Every key has a default (see schema.cpp,
 // `shroudsim --print-defaults`). Units: SI, angles in degrees, frequencies in Hz,
 // speeds in rpm, as in the case file.

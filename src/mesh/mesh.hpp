@@ -1,7 +1,7 @@
 #pragma once
 // The sector mesh: the value type handed from the mesh stage to FE, cyclic and contact.
 //
-// Conventions (../shared/PHYSICS.md section 1):
+// Conventions (docs/physics.md section 1):
 //  - global z is the rotation axis; sector k+1 = sector k rotated by +alpha = 2*pi/sectors;
 //  - node sets (0-based, sorted ascending): "hub" (clamped), "cyclic_low", "cyclic_high",
 //    "shroud_low", "shroud_high";

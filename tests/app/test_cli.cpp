@@ -345,7 +345,7 @@ namespace {
 
 TEST(Cli, ContactCommandWritesTheCircularOrbitSolution) {
   // A circular tangential orbit of radius 1e-6 m beyond the slip radius mu N / kt, at a
-  // constant normal load N = N0 + kn z0 = 1.1 N: |T| = mu N throughout (PHYSICS.md section 6),
+  // constant normal load N = N0 + kn z0 = 1.1 N: |T| = mu N throughout (docs/physics.md section 6),
   // so the first harmonic of Tx has amplitude 0.33 N and the others vanish.
   const Scratch s("contact");
   s.write("c.toml", "name = \"c\"\n[contact]\nmodel = \"full3d\"\nfriction_coefficient = 0.3\nnormal_preload = 1.0\n"

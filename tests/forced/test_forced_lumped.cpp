@@ -37,7 +37,7 @@ struct OneDof {
   }
   /// Relative residual of the describing-function amplitude relation at amplitude a:
   /// (k + kt_eq - m w^2)^2 + (c w + d)^2 = F^2 / a^2, with F_J1 = a1 cos + b1 sin,
-  /// kt_eq = a1 / a, d = -b1 / a (PHYSICS.md section 4, time-continuous Jenkins).
+  /// kt_eq = a1 / a, d = -b1 / a (docs/physics.md section 4, time-continuous Jenkins).
   double describing_function_error(double a, double w) const {
     const double fs = mu * n0;
     double a1 = kt * a, b1 = 0.0;
@@ -160,7 +160,7 @@ TEST(ForcedLumped, StiffJenkinsWithManyHarmonicsApproachesDenHartog) {
 }
 
 TEST(ForcedLumped, DiscreteJenkinsConvergesToTheDescribingFunction) {
-  // "1d" with N samples approaches the time-continuous law as 1/N^2 (PHYSICS.md section 4).
+  // "1d" with N samples approaches the time-continuous law as 1/N^2 (docs/physics.md section 4).
   const OneDof sys;
   frf::LumpedLinearPart linear = sys.linear();
   double previous = 0.0;
@@ -315,7 +315,7 @@ TEST(ForcedLumped, Full3dResponseKeepsItsEnergyBalanceAndIsFrameInvariant) {
       peaks[k] = std::max(peaks[k], r.amplitude);
     }
   }
-  // The coupled law does not depend on the frame angle (PHYSICS.md section 6).
+  // The coupled law does not depend on the frame angle (docs/physics.md section 6).
   EXPECT_NEAR(peaks[1] / peaks[0], 1.0, 1e-4);
 }
 

@@ -1,4 +1,4 @@
-// Contact forces against closed forms (PHYSICS.md sections 4 and 6): Jenkins single
+// Contact forces against closed forms (docs/physics.md sections 4 and 6): Jenkins single
 // harmonic, its convergence with N, the circular orbit, the clipped-cosine normal force,
 // frame invariance, pure stick and a gap that never closes.
 #include <gtest/gtest.h>
@@ -33,7 +33,7 @@ Eigen::VectorXd forces(Model model, TangentialUpdate update, int h, int n, const
   return f;
 }
 
-// The Jenkins coefficients written out independently of the library (PHYSICS.md sec. 4).
+// The Jenkins coefficients written out independently of the library (docs/physics.md sec. 4).
 struct JenkinsRef {
   double a1, b1;
 };

@@ -57,7 +57,7 @@ TEST_P(StiffnessExtremes, FiniteAndJacobianStillExact) {
   }
   EXPECT_LE(shroudsim::testing::median(err), kJacobianMedianTol);
   // A circular orbit of radius 3 mu N0/kt at constant N: |T| = mu N0 at every sample
-  // (PHYSICS.md section 6), whatever the units.
+  // (docs/physics.md section 6), whatever the units.
   {
     const int m = ev.pair_layout().per_direction();
     Eigen::VectorXd wc = Eigen::VectorXd::Zero(s);
