@@ -156,7 +156,7 @@ int frf_auto(Context& ctx) {
   for (const auto& t : trials)
     if (t.h == h && t.n == n) chosen = &t;
   if (!chosen) throw InputError(c.locations.at("hbm.harmonics") + ": hbm \"auto\": no H/N candidate fits the limits (auto_max_harmonics, auto_max_time_samples, time_samples >= 2H+1)");
-  for (const char* f : {"frf.csv", "loops.csv"})
+  for (const char* f : {"frf.csv", "loops.csv", "peaks.csv"})
     if (std::filesystem::exists(chosen->dir / f)) io::write_file_atomic(ctx.out_dir / f, read_file(chosen->dir / f));
   ctx.report.section("frf") = chosen->frf;
   auto& a = ctx.report.section("auto");
@@ -309,6 +309,16 @@ int cmd_frf(Context& ctx) {
       }
     }
     io::write_file_atomic(ctx.out_dir / "loops.csv", loops.str());
+  }
+  // The located resonance peaks (run.json lists them too; the plot reads this file, which is
+  // written before it is drawn).
+  {
+    std::ostringstream pk;
+    pk << "frequency_hz,amplitude_m,located,piece\n";
+    for (const auto& p : response.peaks)
+      pk << io::format_number(p.frequency_hz) << "," << io::format_number(p.amplitude_m) << "," << (p.located ? 1 : 0)
+         << "," << p.piece << "\n";
+    io::write_file_atomic(ctx.out_dir / "peaks.csv", pk.str());
   }
 
   auto& j = ctx.report.section("frf");

@@ -39,8 +39,15 @@ def plot_frf(result_dir):
         for c, k in enumerate(harmonics[2:]):  # h0 is the static part, h1 dominates; show the higher ones
             ax.semilogy(fr, [max(float(rows[i][k]), 1e-30) for i in run], lw=0.7, ls="--", color=f"C{c + 1}",
                         label=k[:-2] if first else None)
-    i = max(range(len(a)), key=lambda j: a[j])
-    ax.plot([f[i]], [a[i]], "o", color="C3", label=f"peak {a[i]:.3g} m at {f[i]:.2f} Hz")
+    # The peak as run.json reports it: the largest of the located peaks (peaks.csv), or the
+    # largest point when none was located (or the file is absent).
+    pf, pa = max(zip(f, a), key=lambda p: p[1])
+    peaks_csv = os.path.join(result_dir, "peaks.csv")
+    if os.path.exists(peaks_csv):
+        for r in _read_csv(peaks_csv):
+            if float(r["amplitude_m"]) >= pa:
+                pf, pa = float(r["frequency_hz"]), float(r["amplitude_m"])
+    ax.plot([pf], [pa], "o", color="C3", label=f"peak {pa:.4g} m at {pf:.3f} Hz")
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("response amplitude max_t |u(t)| [m]")
     ax.set_ylim(bottom=max(min(a) * 1e-3, 1e-14))
