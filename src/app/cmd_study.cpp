@@ -6,6 +6,7 @@
 // `study --convergence CASE` instead measures the accuracy/speed trade of the case's knobs
 // (run_convergence below) -> trade.csv, trade.png; it needs no [study] section.
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <ctime>
 #include <iomanip>
@@ -118,6 +119,11 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
 }
 
 
+/// The mesh ladder of `study --convergence`: kMeshLadder sizes, each kMeshRatio times finer
+/// (about twice the DOFs of the one before).
+constexpr int kMeshLadder = 4;
+const double kMeshRatio = std::cbrt(2.0);
+
 /// `study --convergence`: every knob of the accuracy/speed trade varied one at a time around
 /// the case's own setting, each against its finest value (the reference), with every other
 /// knob at the case's setting. The error of a point is peaks_change (frf_curves.hpp) between
@@ -136,8 +142,16 @@ int run_convergence(Context& ctx) {
   };
   std::vector<Knob> knobs;
   if (sector && c.structure.mesh.empty()) {
+    // Four sizes, each with about twice the DOFs of the one before (h / 2^(1/3)): enough to
+    // see the observed order and extrapolate (mesh_convergence in run.json).
     const double m = c.geometry.mesh_size;
-    knobs.push_back({"mesh size [m]", "geometry.mesh_size", {num(m), num(0.8 * m), num(0.65 * m)}, {}});
+    std::vector<std::string> sizes;
+    for (int i = 0; i < kMeshLadder; ++i) sizes.push_back(num(m * std::pow(kMeshRatio, -i)));
+    knobs.push_back({"mesh size [m]", "geometry.mesh_size", sizes, {}});
+  }
+  if (sector && c.contact.pairs != 0) {
+    // The case's contact elements against one per shroud node pair (at the case's mesh).
+    knobs.push_back({"contact pairs", "contact.pairs", {std::to_string(c.contact.pairs), quoted("all")}, {}});
   }
   if (sector) {
     const int modes = c.modal.modes;
@@ -252,6 +266,35 @@ int run_convergence(Context& ctx) {
   io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());
   ctx.report.section("study") = {{"convergence", true}, {"runs", points.size()}, {"knobs", knobs.size()},
                                  {"failed_rows", failed}, {"workers", workers}};
+  // The mesh ladder: observed order and extrapolated peak (docs/contact_patches.md).
+  for (std::size_t k = 0; k < knobs.size(); ++k) {
+    if (knobs[k].key != "geometry.mesh_size") continue;
+    std::vector<double> sizes, peaks;
+    bool all_ok = true;
+    for (const auto& row : rows)
+      if (row.knob == k) {
+        sizes.push_back(std::stod(row.value));
+        peaks.push_back(points[row.point].peak);
+        all_ok = all_ok && points[row.point].status == 0;
+      }
+    if (!all_ok || peaks.size() < 3) continue;
+    const MeshConvergence mc = mesh_convergence(peaks, kMeshRatio);
+    nlohmann::json j = {{"mesh_sizes_m", sizes}, {"peaks_m", peaks}, {"case_peak_m", peaks.front()},
+                        {"finest_peak_m", peaks.back()}, {"monotone", mc.monotone}};
+    j["observed_order"] = mc.monotone ? nlohmann::json(mc.order) : nlohmann::json(nullptr);
+    j["extrapolated_peak_m"] = mc.monotone ? nlohmann::json(mc.extrapolated) : nlohmann::json(nullptr);
+    j["case_error_estimate"] = mc.case_error;
+    ctx.report.section("mesh_convergence") = j;
+    std::ostringstream s;
+    s << "study --convergence: mesh: peak " << io::format_number(peaks.front()) << " m at the case's size, "
+      << io::format_number(peaks.back()) << " m at the finest";
+    if (mc.monotone)
+      s << "; observed order " << std::setprecision(3) << mc.order << ", extrapolated " << io::format_number(mc.extrapolated) << " m";
+    else
+      s << "; not monotone over the three finest sizes (no extrapolation)";
+    s << "; estimated mesh error of the case: " << std::setprecision(3) << 100.0 * mc.case_error << " %";
+    log::info(s.str());
+  }
   draw_plots(ctx);
   if (failed) {
     ctx.report.warn(std::to_string(failed) + " rows of trade.csv failed (see their folders' run.json)");

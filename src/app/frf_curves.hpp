@@ -26,4 +26,19 @@ double peaks_change(const std::vector<std::pair<double, double>>& a, const std::
 /// peaks_change (the frequency of each curve's window peak).
 double peaks_shift_hz(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b);
 
+/// Richardson extrapolation of a mesh ladder (`study --convergence`).
+struct MeshConvergence {
+  bool monotone = false;     ///< the last three values change in one direction, shrinking
+  double order = 0.0;        ///< observed order p: |e_k| ~ h^p
+  double extrapolated = 0.0; ///< finest + e2 / (r^p - 1)
+  double case_error = 0.0;   ///< |first value - best estimate| / |best estimate|
+};
+
+/// From values on sizes h, h / r, h / r^2, ... (coarse to fine, at least three): with e1, e2
+/// the last two changes, p = ln(e1 / e2) / ln r and the extrapolated value
+/// finest + e2 / (r^p - 1) when they have one sign and shrink. Otherwise (not yet in the
+/// asymptotic range) the best estimate is the finest value, and the error of the first
+/// (the case's) value is taken against it.
+MeshConvergence mesh_convergence(const std::vector<double>& values, double r);
+
 }  // namespace shroudsim::app

@@ -13,24 +13,36 @@ namespace {
 
 using Complex = std::complex<double>;
 
-/// C_h = [B; D; E] (k x n_full) for harmonic index h.
-Eigen::SparseMatrix<Complex> selection(const std::vector<SectorContactPair>& pairs, const SectorForcing& f,
-                                       const cyclic::CyclicSector& sector, int h, Eigen::Index n_full) {
+void add_contact_rows(std::vector<Eigen::Triplet<Complex>>& t, const std::vector<SectorContactPair>& pairs,
+                      const cyclic::CyclicSector& sector, int h) {
   const double alpha = 2.0 * std::numbers::pi / sector.sectors();
   const Eigen::Matrix3d rot = cyclic::rotation_z(alpha);
   const Complex phase = std::exp(Complex(0.0, h * alpha));
-  std::vector<Eigen::Triplet<Complex>> t;
-  const int c = 3 * static_cast<int>(pairs.size());
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const Eigen::Matrix3d& l = pairs[i].frame;
     const Eigen::Matrix3d lr = l * rot;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        const int row = 3 * static_cast<int>(i) + a;
-        t.emplace_back(row, 3 * pairs[i].high_node + b, l(a, b));
-        t.emplace_back(row, 3 * pairs[i].low_node + b, -phase * lr(a, b));
-      }
+    auto node_pair = [&](int high, int low, double weight) {
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          const int row = 3 * static_cast<int>(i) + a;
+          t.emplace_back(row, 3 * high + b, weight * l(a, b));
+          t.emplace_back(row, 3 * low + b, -phase * (weight * lr(a, b)));
+        }
+    };
+    if (pairs[i].patch.empty()) {
+      node_pair(pairs[i].high_node, pairs[i].low_node, 1.0);  // 1.0 * x == x: the node form exactly
+    } else {
+      for (const PatchNode& m : pairs[i].patch) node_pair(m.high_node, m.low_node, m.weight);
+    }
   }
+}
+
+/// C_h = [B; D; E] (k x n_full) for harmonic index h.
+Eigen::SparseMatrix<Complex> selection(const std::vector<SectorContactPair>& pairs, const SectorForcing& f,
+                                       const cyclic::CyclicSector& sector, int h, Eigen::Index n_full) {
+  std::vector<Eigen::Triplet<Complex>> t;
+  add_contact_rows(t, pairs, sector, h);
+  const int c = 3 * static_cast<int>(pairs.size());
   for (int a = 0; a < 3; ++a) t.emplace_back(c + a, 3 * f.response_node + a, 1.0);
   for (int a = 0; a < 3; ++a) t.emplace_back(c + 3, 3 * f.excitation_node + a, f.force[a]);
   Eigen::SparseMatrix<Complex> m(c + 4, n_full);
@@ -39,6 +51,15 @@ Eigen::SparseMatrix<Complex> selection(const std::vector<SectorContactPair>& pai
 }
 
 }  // namespace
+
+Eigen::SparseMatrix<Complex> contact_rows(const std::vector<SectorContactPair>& pairs, const cyclic::CyclicSector& sector,
+                                          int h, Eigen::Index n_full) {
+  std::vector<Eigen::Triplet<Complex>> t;
+  add_contact_rows(t, pairs, sector, h);
+  Eigen::SparseMatrix<Complex> m(3 * static_cast<Eigen::Index>(pairs.size()), n_full);
+  m.setFromTriplets(t.begin(), t.end());
+  return m;
+}
 
 int SectorLinearPart::harmonic_index(int n) const {
   return ((n * forcing_.engine_order) % sectors_ + sectors_) % sectors_;

@@ -12,8 +12,11 @@
 //   R_0    = T_0 K_0^-1 T_0^T                                                 (n = 0)
 // Contact pair i joins high node q (shroud_high of sector k) and the low node p' of
 // sector k+1, p' = R p with p the matched shroud_low node of the reference sector:
-//   W_n,i = L_i (U_q,n - exp(i h_n alpha) R U_p,n),   L_i = [t1; t2; n] (rows).
+//   W_n,i = L_i (U_q,n - exp(i h_n alpha) R U_p,n),   L_i = [t1; t2; n] (rows),
+// or, for a contact patch, the weighted sum of that over the patch's node pairs.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <complex>
 #include <functional>
 #include <map>
 #include <vector>
@@ -24,10 +27,20 @@
 
 namespace shroudsim::frf {
 
+/// One node pair of a contact patch and its weight (frf/contact_patches.hpp).
+struct PatchNode {
+  int high_node = -1, low_node = -1;
+  double weight = 0.0;  ///< a_i / A_P
+};
+
 struct SectorContactPair {
   int high_node = -1;   ///< q: shroud_high node of the reference sector
   int low_node = -1;    ///< p: its matched shroud_low node (x_q = R x_p)
   Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();  ///< rows t1, t2, n (n outward of shroud_high)
+  /// Empty: the element acts on the node pair (high_node, low_node). Otherwise on the
+  /// weighted mean of these node pairs, W = L sum_i weight_i (U_q_i - exp(i h alpha) R U_p_i),
+  /// and its force is spread over them with the same weights (the transpose).
+  std::vector<PatchNode> patch;
 };
 
 struct SectorForcing {
@@ -38,6 +51,11 @@ struct SectorForcing {
   double damping_ratio = 0.001;      ///< modal damping of every mode
   bool residual_flexibility = true;
 };
+
+/// The contact rows B_h (3 per pair, n_full columns) of harmonic index h: row 3i + a is
+/// L_i(a, :) (u_q - exp(i h alpha) R u_p), summed with weights over a patch.
+Eigen::SparseMatrix<std::complex<double>> contact_rows(const std::vector<SectorContactPair>& pairs,
+                                                       const cyclic::CyclicSector& sector, int h, Eigen::Index n_full);
 
 class SectorLinearPart : public LinearPart {
  public:

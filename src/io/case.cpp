@@ -487,6 +487,7 @@ void read_all(Reader& r, Case& c) {
       co.pairs = r.integer(key, in_range_int(1, 1'000'000));
     }
   }
+  co.discretization = r.string("contact.discretization", {"patches", "nodes"});
   co.friction_coefficient = r.number("contact.friction_coefficient", non_negative);
   co.normal_stiffness = r.number("contact.normal_stiffness", positive);
   co.tangential_stiffness = r.number("contact.tangential_stiffness", positive);

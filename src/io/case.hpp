@@ -83,6 +83,7 @@ struct ContactElement {
 struct ContactSection {
   std::string model = "full3d";          ///< full3d | quasi3d | 1d | 1d_exact
   int pairs = 0;                         ///< 0: "all"
+  std::string discretization = "patches"; ///< "patches" | "nodes" (sector only)
   double friction_coefficient = 0.3;
   double normal_stiffness = 1.0e6;       ///< N/m per interface
   double tangential_stiffness = 1.0e6;   ///< N/m per interface

@@ -73,7 +73,8 @@ const std::vector<KeySpec>& case_schema() {
       {"response.dof", "0", "0 <= dof < n (lumped only)", "lumped: the response DOF"},
 
       {"contact.model", "\"full3d\"", "\"full3d\" | \"quasi3d\" | \"1d\" | \"1d_exact\"", "friction contact model"},
-      {"contact.pairs", "\"all\"", "\"all\" or a count >= 1", "contact node pairs used, chosen evenly over the shroud face"},
+      {"contact.pairs", "\"all\"", "\"all\" or a count >= 1", "contact elements on the shroud face: the face split into this many patches (seeds spread evenly, each node to its nearest seed)"},
+      {"contact.discretization", "\"patches\"", "\"patches\" | \"nodes\"", "sector: patches = each element acts on its patch's area-weighted mean relative displacement (converges under mesh refinement); nodes = on the patch's seed node pair alone (the paper's model)"},
       {"contact.friction_coefficient", "0.3", ">= 0", "Coulomb friction coefficient mu"},
       {"contact.normal_stiffness", "1.0e6", "> 0", "normal contact stiffness per interface (N/m), shared over pairs by tributary area"},
       {"contact.tangential_stiffness", "1.0e6", "> 0", "tangential contact stiffness per interface (N/m)"},
