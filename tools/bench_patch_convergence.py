@@ -22,7 +22,9 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def run(exe, case, sets, out, threads, timeout, reuse):
+def run(exe, case, sets, out, threads, timeout, reuse, no_run=False):
+    if no_run and not os.path.exists(os.path.join(out, "run.json")):
+        return {"status": "not run", "wall": 0.0}
     if not (reuse and os.path.exists(os.path.join(out, "run.json"))):
         cmd = [exe, "frf", case, "--quiet", "--threads", str(threads), "--out", out]
         for s in sets:
@@ -76,6 +78,7 @@ def main():
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=7200.0)
     ap.add_argument("--reuse", action="store_true", help="read existing results instead of running again")
+    ap.add_argument("--no-run", action="store_true", help="only read existing results (table and plot)")
     ap.add_argument("--plot", help="PNG: peak against element size")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
@@ -93,7 +96,7 @@ def main():
                 pv = f'"{pairs}"' if pairs == "all" else pairs
                 sets = [f"geometry.mesh_size={size!r}", f"contact.pairs={pv}", f'contact.discretization="{disc}"',
                         f"continuation.frequency_start_hz={a.range[0]!r}", f"continuation.frequency_end_hz={a.range[1]!r}"]
-                r = run(a.exe, case, sets, out, a.threads, a.timeout, a.reuse)
+                r = run(a.exe, case, sets, out, a.threads, a.timeout, a.reuse or a.no_run, a.no_run)
                 r.update({"size": size, "pairs_key": pairs, "disc": disc})
                 rows.append(r)
                 print(f"{name}: {r['status']} peak {r.get('peak')} at {r.get('peak_hz')} Hz, {r['wall']:.1f} s", flush=True)
