@@ -9,6 +9,7 @@
 #include <set>
 #include <tuple>
 #include <sstream>
+#include <stdexcept>
 
 #include "app/forced_stage.hpp"
 #include "app/modal_stage.hpp"
@@ -44,14 +45,15 @@ ForcedModel make_sector_model(Context& ctx) {
 
   const std::vector<frf::ShroudFaceNode> face = frf::shroud_face(mesh);
   if (face.empty()) throw InputError(c.file.string() + ": the mesh has no matched shroud node pairs");
-  const int count = c.contact.pairs == 0 ? static_cast<int>(face.size()) : c.contact.pairs;
-  if (count > static_cast<int>(face.size()))
-    throw InputError(c.locations.at("contact.pairs") + ": contact.pairs = " + std::to_string(count) +
-                     " violates: pairs <= matched shroud node pairs of the mesh (" + std::to_string(face.size()) + ")");
   frf::ContactDiscretization discretization = frf::ContactDiscretization::patches;
   frf::parse_discretization(c.contact.discretization, discretization);  // checked by the case reader
   // Each patch gets the share A_P / A of the face's stiffness and preload.
-  const std::vector<frf::ContactPatch> patches = frf::partition_face(mesh, face, count);
+  std::vector<frf::ContactPatch> patches;
+  try {
+    patches = frf::partition_face(mesh, face, c.contact.pairs);  // 0: "all"
+  } catch (const std::invalid_argument& e) {  // more pairs than the face has
+    throw InputError(c.locations.at("contact.pairs") + ": contact." + e.what());
+  }
   std::vector<frf::SectorContactPair> pairs =
       frf::contact_pairs(mesh, face, patches, discretization, c.contact.frame_angle_deg * kDeg);
   double total = 0.0;

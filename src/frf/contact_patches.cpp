@@ -137,10 +137,10 @@ std::vector<SectorContactPair> contact_pairs(const mesh::Mesh& m, const std::vec
     SectorContactPair c;
     c.high_node = seed.high;
     c.low_node = seed.low;
-    if (discretization == ContactDiscretization::nodes || p.members.size() == 1) {
-      c.frame = contact_frame(seed.normal, m.nodes.row(seed.high).transpose(), frame_angle);
-    } else {
-      c.frame = contact_frame(p.normal, m.nodes.row(seed.high).transpose(), frame_angle);
+    // A single-member patch's normal is its seed's (partition_face): the node form exactly.
+    const bool spread = discretization == ContactDiscretization::patches && p.members.size() > 1;
+    c.frame = contact_frame(spread ? p.normal : seed.normal, m.nodes.row(seed.high).transpose(), frame_angle);
+    if (spread) {
       for (std::size_t k = 0; k < p.members.size(); ++k) {
         const ShroudFaceNode& f = face[static_cast<std::size_t>(p.members[k])];
         c.patch.push_back({f.high, f.low, p.weights[k]});

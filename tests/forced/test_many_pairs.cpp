@@ -3,25 +3,21 @@
 // plain dense forms they replace (forced/reduced_equations.hpp), on a lumped model with three
 // 3D contacts and on a coarse FE sector with all its shroud pairs.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
-#include <filesystem>
 #include <numbers>
 #include <random>
 
+#include "../common/coarse_sector.hpp"
 #include "continuation/arclength.hpp"
 #include "cyclic/cyclic_sector.hpp"
-#include "fe/assembly.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/lumped.hpp"
 #include "three_contacts.hpp"
 #include "frf/sector.hpp"
 #include "hbm/contact_evaluator.hpp"
-#include "mesh/msh_reader.hpp"
-#include "mesh/sector_generator.hpp"
 #include "modal/harmonic.hpp"
 
 namespace shroudsim::forced {
@@ -219,23 +215,11 @@ TEST(ManyPairs, ContinuationWithTheKrylovSolveTracesTheSameCurveAsTheDenseOne) {
 
 // ---- FE sector: every shroud pair of a coarse mesh ------------------------------------
 
-struct Sector {
-  mesh::Mesh mesh;
-  linalg::SparsePair<double> km;
-  std::unique_ptr<cyclic::CyclicSector> sector;
+struct Sector : testing_support::CoarseSector {
   std::map<int, modal::ModalBasis> bases;
   std::map<int, modal::StiffnessFactor> factors;
 
-  Sector() {
-    mesh::SectorGeometry g;
-    g.element_order = 1;
-    g.mesh_size = 0.03;
-    const auto file = std::filesystem::temp_directory_path() / ("shroudsim_many_" + std::to_string(::getpid()) + ".msh");
-    mesh::generate_sector_mesh(g, file, false);
-    mesh = mesh::read_sector_mesh(file, {g.sectors, 1e-9});
-    std::filesystem::remove(file);
-    km = fe::assemble(mesh, fe::Material{});
-    sector = std::make_unique<cyclic::CyclicSector>(mesh, km);
+  Sector() : CoarseSector("many") {
     modal::ModalOptions mo;
     mo.modes = 8;
     for (int h : {0, 1, 2}) {

@@ -3,23 +3,19 @@
 // its force spreading, the limit of one pair per patch, and the stuck patch model against a
 // direct FE solve with the patch springs in the stiffness.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cstring>
-#include <filesystem>
 #include <numbers>
 #include <set>
 
+#include "../common/coarse_sector.hpp"
 #include "cyclic/cyclic_sector.hpp"
-#include "fe/assembly.hpp"
 #include "frf/contact_patches.hpp"
 #include "frf/sector.hpp"
-#include "mesh/msh_reader.hpp"
-#include "mesh/sector_generator.hpp"
 #include "modal/harmonic.hpp"
 
 namespace shroudsim::frf {
@@ -27,24 +23,9 @@ namespace {
 
 using Complex = std::complex<double>;
 
-struct Fixture {
-  mesh::Mesh mesh;
-  linalg::SparsePair<double> km;
-  std::unique_ptr<cyclic::CyclicSector> sector;
+struct Fixture : testing_support::CoarseSector {
   std::vector<ShroudFaceNode> face;
-
-  explicit Fixture(int order = 2) {
-    mesh::SectorGeometry g;
-    g.element_order = order;
-    g.mesh_size = 0.03;
-    const auto file = std::filesystem::temp_directory_path() / ("shroudsim_patch_" + std::to_string(::getpid()) + ".msh");
-    mesh::generate_sector_mesh(g, file, false);
-    mesh = mesh::read_sector_mesh(file, {g.sectors, 1e-9});
-    std::filesystem::remove(file);
-    km = fe::assemble(mesh, fe::Material{});
-    sector = std::make_unique<cyclic::CyclicSector>(mesh, km);
-    face = shroud_face(mesh);
-  }
+  Fixture() : CoarseSector("patch", /*element_order=*/2) { face = shroud_face(mesh); }
 };
 
 const Fixture& fixture() {

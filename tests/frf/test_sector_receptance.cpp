@@ -1,18 +1,14 @@
 // The sector's modal receptances (with residual flexibility) against a direct solve of
 // the cyclic system (K_h - W^2 M_h)^-1 at the contact, response and excitation DOFs.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseLU>
-#include <filesystem>
 #include <numbers>
 
+#include "../common/coarse_sector.hpp"
 #include "cyclic/cyclic_sector.hpp"
-#include "fe/assembly.hpp"
 #include "frf/sector.hpp"
-#include "mesh/msh_reader.hpp"
-#include "mesh/sector_generator.hpp"
 #include "modal/harmonic.hpp"
 
 namespace shroudsim::frf {
@@ -20,22 +16,8 @@ namespace {
 
 using Complex = std::complex<double>;
 
-struct Fixture {
-  mesh::Mesh mesh;
-  linalg::SparsePair<double> km;
-  std::unique_ptr<cyclic::CyclicSector> sector;
-
-  Fixture() {
-    mesh::SectorGeometry g;
-    g.element_order = 1;
-    g.mesh_size = 0.03;
-    const auto file = std::filesystem::temp_directory_path() / ("shroudsim_rec_" + std::to_string(::getpid()) + ".msh");
-    mesh::generate_sector_mesh(g, file, false);
-    mesh = mesh::read_sector_mesh(file, {g.sectors, 1e-9});
-    std::filesystem::remove(file);
-    km = fe::assemble(mesh, fe::Material{});
-    sector = std::make_unique<cyclic::CyclicSector>(mesh, km);
-  }
+struct Fixture : testing_support::CoarseSector {
+  Fixture() : CoarseSector("rec") {}
 };
 
 /// `count` matched shroud pairs (every `stride`-th), frames turned about `axis` by
