@@ -117,9 +117,61 @@ SparseMatrixC combine(const SparseMatrixD& A, const SparseMatrixD& B, Complex e)
 }
 }  // namespace
 
+void CyclicSector::set_interface(std::vector<InterfaceSpring> springs) {
+  const Eigen::Index n_nodes = n_full_ / 3;
+  for (const auto& s : springs) {
+    if (s.high_node < 0 || s.high_node >= n_nodes || s.low_node < 0 || s.low_node >= n_nodes)
+      throw InputError("interface spring: node out of range");
+    if (!s.stiffness.allFinite() || (s.stiffness.array() < 0).any() || !s.frame.allFinite())
+      throw InputError("interface spring: stiffness must be finite and >= 0, frame finite");
+  }
+  springs_ = std::move(springs);
+}
+
+SparseMatrixC CyclicSector::interface_rows(int h) const {
+  const Complex e = phase(h);
+  const Eigen::Matrix3d R = rotation_z(2.0 * std::numbers::pi / sectors_);
+  std::vector<Eigen::Triplet<Complex>> t;
+  t.reserve(springs_.size() * 18);
+  for (std::size_t i = 0; i < springs_.size(); ++i) {
+    const InterfaceSpring& s = springs_[i];
+    const Eigen::Matrix3d LR = s.frame * R;
+    for (int a = 0; a < 3; ++a) {
+      const int row = static_cast<int>(3 * i) + a;
+      for (int j = 0; j < 3; ++j) {
+        if (s.frame(a, j) != 0.0) t.emplace_back(row, 3 * s.high_node + j, s.frame(a, j));
+        if (LR(a, j) != 0.0) t.emplace_back(row, 3 * s.low_node + j, -e * LR(a, j));
+      }
+    }
+  }
+  SparseMatrixC S(static_cast<Eigen::Index>(3 * springs_.size()), n_full_);
+  S.setFromTriplets(t.begin(), t.end());  // a spring from a node to itself sums its entries
+  return S;
+}
+
+SparseMatrixC CyclicSector::interface_stiffness(int h) const {
+  if (springs_.empty()) return {};
+  const SparseMatrixC Y = interface_rows(h) * expansion(h);
+  Eigen::VectorXcd k(Y.rows());
+  for (std::size_t i = 0; i < springs_.size(); ++i)
+    for (int a = 0; a < 3; ++a) k[static_cast<Eigen::Index>(3 * i) + a] = springs_[i].stiffness[a];
+  const SparseMatrixC kY = k.asDiagonal() * Y;
+  SparseMatrixC out = SparseMatrixC(Y.adjoint()) * kY;
+  // Exactly Hermitian (the product's two triangles are summed in different orders).
+  const SparseMatrixC outH = out.adjoint();
+  out = 0.5 * (out + outH);
+  out.makeCompressed();
+  return out;
+}
+
 linalg::SparsePair<Complex> CyclicSector::reduce(int h) const {
   const Complex e = phase(h);
-  return {combine(KA_, KB_, e), combine(MA_, MB_, e)};
+  linalg::SparsePair<Complex> out{combine(KA_, KB_, e), combine(MA_, MB_, e)};
+  if (!springs_.empty()) {
+    out.K = out.K + interface_stiffness(h);
+    out.K.makeCompressed();
+  }
+  return out;
 }
 
 linalg::SparsePair<double> CyclicSector::reduce_real(int h) const {
@@ -131,7 +183,12 @@ linalg::SparsePair<double> CyclicSector::reduce_real(int h) const {
     out.makeCompressed();
     return out;
   };
-  return {combine_real(KA_, KB_), combine_real(MA_, MB_)};
+  linalg::SparsePair<double> out{combine_real(KA_, KB_), combine_real(MA_, MB_)};
+  if (!springs_.empty()) {
+    out.K = out.K + SparseMatrixD(interface_stiffness(h).real());
+    out.K.makeCompressed();
+  }
+  return out;
 }
 
 SparseMatrixC CyclicSector::expansion(int h) const {

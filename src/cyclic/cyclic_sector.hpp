@@ -18,6 +18,15 @@
 //   cyclic::CyclicSector sector(mesh, assembler.assemble(material));
 //   linalg::SparsePair<linalg::Complex> kmh = sector.reduce(h);
 //   Eigen::MatrixXcd u_full = sector.expand(h, phi);      // 3 * n_nodes rows, all nodes
+//
+// Interface springs (the stuck shroud, docs/physics.md section 1): a spring joins node q of
+// a sector to node p of the next sector (x_q = R x_p). Its relative displacement in the
+// spring's frame L (rows t1, t2, n) is, for harmonic index h,
+//   g = L (u_q - exp(i h alpha) R u_p) = Y_h u_r,   Y_h = S_h T_h,
+// (the operator of the relative displacement of the forced response's contact pairs), and
+// its energy g^H diag(k) g / 2 adds  Y_h^H diag(k) Y_h  to K_h (Hermitian, positive
+// semidefinite; real for h = 0 and h = Nb/2). set_interface() makes every reduction include
+// it, so modes, static solves and speed sweeps of the sector all see the springs.
 #include <vector>
 
 #include "linalg/sparse.hpp"
@@ -30,6 +39,14 @@ Eigen::Matrix3d rotation_z(double angle);
 
 /// Nodal diameter of harmonic index h: min(h mod Nb, Nb - h mod Nb).
 int nodal_diameter(int h, int sectors);
+
+/// A spring across the sector boundary: node `high_node` of a sector to node `low_node` of
+/// the next one (x_high = R x_low), with stiffness along the rows t1, t2, n of `frame`.
+struct InterfaceSpring {
+  int high_node = -1, low_node = -1;
+  Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();  ///< rows t1, t2, n
+  Eigen::Vector3d stiffness = Eigen::Vector3d::Zero();  ///< k_t1, k_t2, k_n [N/m], >= 0
+};
 
 class CyclicSector {
  public:
@@ -55,6 +72,14 @@ class CyclicSector {
   linalg::SparsePair<linalg::Complex> reduce(int h) const;
   /// Real K_h, M_h for is_real(h).
   linalg::SparsePair<double> reduce_real(int h) const;
+  /// Interface springs added to every reduced K_h from now on (replaces any set before).
+  /// Throws InputError for a node out of range or a negative or non-finite stiffness.
+  void set_interface(std::vector<InterfaceSpring> springs);
+  const std::vector<InterfaceSpring>& interface() const { return springs_; }
+  /// S_h: the relative displacements of the springs (3 rows per spring, row 3i + a is
+  /// L_i(a, :) (u_q - exp(i h alpha) R u_p)) from all n_full sector DOFs.
+  linalg::SparseMatrixC interface_rows(int h) const;
+
   /// T_h: n_full x n_reduced (complex; real-valued for is_real(h)).
   linalg::SparseMatrixC expansion(int h) const;
   /// T_h u: reduced DOF vectors (columns) to all sector DOFs, cyclic_high nodes included.
@@ -67,6 +92,9 @@ class CyclicSector {
   std::vector<int> reduced_to_full_, clamped_dofs_;
   linalg::SparseMatrixD P_, G_;        // n_full x n_reduced
   linalg::SparseMatrixD KA_, KB_, MA_, MB_;
+  std::vector<InterfaceSpring> springs_;
+  /// Y_h^H diag(k) Y_h on the reduced DOFs (empty matrix without springs).
+  linalg::SparseMatrixC interface_stiffness(int h) const;
 };
 
 }  // namespace shroudsim::cyclic

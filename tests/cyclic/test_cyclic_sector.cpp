@@ -2,7 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "core/error.hpp"
@@ -132,6 +135,185 @@ TEST(CyclicSector, MismatchedPairsAreRejected) {
   mesh::Mesh m = fe::annular_sector_mesh(small_sector(6, 1));
   m.nodes(m.cyclic_pairs.front().second, 2) += 1e-3;
   EXPECT_THROW(CyclicSector(m, fe::assemble(m, kSteel, 1)), InputError);
+}
+
+
+// ---- Interface springs (the stuck shroud) against the full wheel ----
+
+// Node of the sector at (r, theta / alpha, z) nearest to the given point (an exact grid node).
+int node_at(const mesh::Mesh& m, double r, double theta_fraction, double z) {
+  const double a = 2.0 * std::numbers::pi / m.sectors * theta_fraction;
+  const Eigen::Vector3d x(r * std::cos(a), r * std::sin(a), z);
+  int best = -1;
+  double d_best = 1e300;
+  for (int v = 0; v < m.n_nodes(); ++v) {
+    const double d = (m.nodes.row(v).transpose() - x).norm();
+    if (d < d_best) best = v, d_best = d;
+  }
+  return best;
+}
+
+// Two springs from nodes near theta = alpha of a sector to nodes near theta = 0 of the next,
+// one of them from a cyclic_high node, with turned frames and unequal stiffnesses.
+std::vector<InterfaceSpring> test_springs(const mesh::Mesh& m, double k) {
+  std::vector<InterfaceSpring> springs(2);
+  springs[0].high_node = node_at(m, 0.2, 0.75, 0.03);
+  springs[0].low_node = node_at(m, 0.2, 0.25, 0.03);
+  springs[1].high_node = node_at(m, 0.2, 1.0, 0.0);  // on cyclic_high
+  springs[1].low_node = node_at(m, 0.15, 0.25, 0.0);
+  springs[0].frame = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  springs[1].frame = Eigen::AngleAxisd(-1.1, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
+  springs[0].stiffness = Eigen::Vector3d(0.5, 0.7, 2.0) * k;
+  springs[1].stiffness = Eigen::Vector3d(1.0, 0.3, 1.5) * k;
+  return springs;
+}
+
+// Wheel node of node v of sector copy k (replicate_wheel's numbering).
+int wheel_node(const mesh::Mesh& sector, int k, int v) {
+  const int nb = sector.sectors, n = sector.n_nodes();
+  std::vector<int> partner_low(n, -1), kept(n, -1);
+  for (const auto& [p, q] : sector.cyclic_pairs) partner_low[q] = p;
+  int n_kept = 0;
+  for (int u = 0; u < n; ++u)
+    if (partner_low[u] < 0) kept[u] = n_kept++;
+  if (partner_low[v] >= 0) return ((k + 1) % nb) * n_kept + kept[partner_low[v]];
+  return k * n_kept + kept[v];
+}
+
+// Eigenvalues of the full wheel (hub clamped) with the springs of every sector added to K
+// directly (stiffness matrix assembled in global coordinates).
+Eigen::VectorXd wheel_with_springs(const mesh::Mesh& sector_mesh, const std::vector<InterfaceSpring>& springs) {
+  const int nb = sector_mesh.sectors;
+  const mesh::Mesh wheel = fe::replicate_wheel(sector_mesh);
+  const auto kmw = fe::assemble(wheel, kSteel, 1);
+  Eigen::MatrixXd K(kmw.K);
+  for (int k = 0; k < nb; ++k) {
+    const Eigen::Matrix3d Rk = rotation_z(2.0 * std::numbers::pi * k / nb);
+    for (const auto& s : springs) {
+      const int a = wheel_node(sector_mesh, k, s.high_node), b = wheel_node(sector_mesh, (k + 1) % nb, s.low_node);
+      const Eigen::Matrix3d L = s.frame * Rk.transpose();  // the frame turned with copy k
+      const Eigen::Matrix3d Ks = L.transpose() * s.stiffness.asDiagonal() * L;
+      K.block<3, 3>(3 * a, 3 * a) += Ks;
+      K.block<3, 3>(3 * b, 3 * b) += Ks;
+      K.block<3, 3>(3 * a, 3 * b) -= Ks;
+      K.block<3, 3>(3 * b, 3 * a) -= Ks;
+    }
+  }
+  const auto free = fe::free_dofs(wheel.n_dofs(), fe::node_dofs(wheel.node_set(mesh::kHub)));
+  std::vector<int> f(free.begin(), free.end());
+  Eigen::MatrixXd Kf(f.size(), f.size()), Mf(f.size(), f.size());
+  const Eigen::MatrixXd M(kmw.M);
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (std::size_t j = 0; j < f.size(); ++j) Kf(i, j) = K(f[i], f[j]), Mf(i, j) = M(f[i], f[j]);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Kf, Mf, Eigen::EigenvaluesOnly);
+  return es.eigenvalues();
+}
+
+std::vector<double> cyclic_union(const CyclicSector& sector) {
+  std::vector<double> ev;
+  for (int h = 0; h < sector.sectors(); ++h) {
+    const auto km = sector.reduce(h);
+    const auto e = dense_eigenvalues(Eigen::MatrixXcd(km.K), Eigen::MatrixXcd(km.M));
+    ev.insert(ev.end(), e.begin(), e.end());
+  }
+  std::sort(ev.begin(), ev.end());
+  return ev;
+}
+
+double max_relative_frequency_difference(const Eigen::VectorXd& wheel_ev, const std::vector<double>& cyclic_ev,
+                                         int count) {
+  double worst = 0.0;
+  for (int i = 0; i < count; ++i)
+    worst = std::max(worst, std::abs(std::sqrt(wheel_ev(i)) - std::sqrt(cyclic_ev[i])) / std::sqrt(wheel_ev(i)));
+  return worst;
+}
+
+class WheelWithSprings : public ::testing::TestWithParam<int> {};
+
+TEST_P(WheelWithSprings, CyclicSpringsEqualTheWheelWithSprings) {
+  const int nb = GetParam();
+  const mesh::Mesh m = fe::annular_sector_mesh(small_sector(nb, 2));
+  CyclicSector sector(m, fe::assemble(m, kSteel, 1));
+  const std::vector<double> open = cyclic_union(sector);
+  // Springs as stiff as the plate's own diagonal: they change the spectrum at order one.
+  const double k = Eigen::VectorXd(Eigen::MatrixXd(fe::assemble(m, kSteel, 1).K).diagonal()).maxCoeff();
+  sector.set_interface(test_springs(m, k));
+  const std::vector<double> stuck = cyclic_union(sector);
+  const Eigen::VectorXd wheel = wheel_with_springs(m, sector.interface());
+  ASSERT_EQ(static_cast<Eigen::Index>(stuck.size()), wheel.size());
+  // Same bound as the open wheel above (dense eigenvalues carry ~1e-12 relative rounding).
+  constexpr double kRelTol = 1e-8;
+  const double worst = max_relative_frequency_difference(wheel, stuck, static_cast<int>(stuck.size()));
+  EXPECT_LT(worst, kRelTol);
+  // The springs matter: the lowest frequencies move by far more than the tolerance.
+  EXPECT_GT(std::sqrt(stuck[0] / open[0]) - 1.0, 1e-3);
+  std::printf("  Nb %d: springs move the first frequency by %.2f %%; wheel vs cyclic %.2e\n", nb,
+              100 * (std::sqrt(stuck[0] / open[0]) - 1.0), worst);
+  // Hermitian, K_{Nb-h} = conj(K_h), real for h = 0.
+  for (int h = 0; h < nb; ++h) {
+    const Eigen::MatrixXcd K(sector.reduce(h).K), Kc(sector.reduce((nb - h) % nb).K);
+    EXPECT_LT((K - K.adjoint()).norm(), 1e-14 * K.norm()) << h;
+    EXPECT_LT((Kc - K.conjugate()).norm(), 1e-14 * K.norm()) << h;
+  }
+  EXPECT_EQ((Eigen::MatrixXd(sector.reduce_real(0).K) - Eigen::MatrixXcd(sector.reduce(0).K).real()).norm(), 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Wheels, WheelWithSprings, ::testing::Values(5, 6));
+
+// Very stiff springs tie the node pairs: the spectrum tends to that of the wheel with the
+// tied nodes merged (constraints applied directly), with an error that falls like 1 / k.
+TEST(CyclicSector, StiffSpringsTendToTheTiedWheel) {
+  const int nb = 5;
+  const mesh::Mesh m = fe::annular_sector_mesh(small_sector(nb, 2));
+  CyclicSector sector(m, fe::assemble(m, kSteel, 1));
+  const double kd = Eigen::VectorXd(Eigen::MatrixXd(fe::assemble(m, kSteel, 1).K).diagonal()).maxCoeff();
+  std::vector<InterfaceSpring> springs = test_springs(m, 1.0);
+  // The tied wheel: node b = (k+1, low) replaced by a = (k, high) in every element.
+  const mesh::Mesh wheel = fe::replicate_wheel(m);
+  std::vector<int> target(wheel.n_nodes());
+  for (int v = 0; v < wheel.n_nodes(); ++v) target[v] = v;
+  for (int k = 0; k < nb; ++k)
+    for (const auto& s : springs) target[wheel_node(m, (k + 1) % nb, s.low_node)] = wheel_node(m, k, s.high_node);
+  const auto kmw = fe::assemble(wheel, kSteel, 1);
+  std::vector<bool> hub(wheel.n_nodes(), false);
+  for (int v : wheel.node_set(mesh::kHub)) hub[v] = true;
+  // Z: wheel DOFs -> independent DOFs (tied nodes share their target's columns).
+  std::vector<int> column(wheel.n_dofs(), -1);
+  int n_ind = 0;
+  for (int v = 0; v < wheel.n_nodes(); ++v)
+    if (target[v] == v && !hub[v])
+      for (int c = 0; c < 3; ++c) column[3 * v + c] = n_ind++;
+  Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(wheel.n_dofs(), n_ind);
+  for (int v = 0; v < wheel.n_nodes(); ++v)
+    for (int c = 0; c < 3; ++c)
+      if (column[3 * target[v] + c] >= 0) Z(3 * v + c, column[3 * target[v] + c]) = 1.0;
+  const Eigen::MatrixXd Kt = Z.transpose() * Eigen::MatrixXd(kmw.K) * Z, Mt = Z.transpose() * Eigen::MatrixXd(kmw.M) * Z;
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Kt, Mt, Eigen::EigenvaluesOnly);
+  const Eigen::VectorXd tied = es.eigenvalues();
+  // Penalty error of the lowest 20 modes at k = 1e3 and 1e4 times the largest diagonal entry.
+  constexpr int kModes = 20;
+  double errors[2];
+  for (int i = 0; i < 2; ++i) {
+    for (auto& s : springs) s.stiffness = Eigen::Vector3d::Constant(kd * (i == 0 ? 1e3 : 1e4));
+    sector.set_interface(springs);
+    errors[i] = max_relative_frequency_difference(tied, cyclic_union(sector), kModes);
+  }
+  std::printf("  tied wheel vs stiff springs: %.2e (1e3 kd), %.2e (1e4 kd)\n", errors[0], errors[1]);
+  EXPECT_LT(errors[1], 1e-4);
+  // First order in 1 / k: ten times stiffer, about ten times closer (at least 5x).
+  EXPECT_LT(errors[1], errors[0] / 5.0);
+}
+
+TEST(CyclicSector, InterfaceSpringsAreChecked) {
+  const mesh::Mesh m = fe::annular_sector_mesh(small_sector(6, 1));
+  CyclicSector sector(m, fe::assemble(m, kSteel, 1));
+  std::vector<InterfaceSpring> bad(1);
+  bad[0].high_node = 0, bad[0].low_node = m.n_nodes();
+  EXPECT_THROW(sector.set_interface(bad), InputError);
+  bad[0].low_node = 1, bad[0].stiffness = Eigen::Vector3d(1.0, -1.0, 1.0);
+  EXPECT_THROW(sector.set_interface(bad), InputError);
+  bad[0].stiffness = Eigen::Vector3d(1.0, std::nan(""), 1.0);
+  EXPECT_THROW(sector.set_interface(bad), InputError);
 }
 
 }  // namespace
