@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Plots of a shroudsim result folder (matplotlib).
 
-usage: tools/plot.py RESULT_DIR
+usage: tools/plot.py RESULT_DIR [--shroud open|stuck]
+
+--shroud names the shroud state of the modal model in the titles of nd_map.png and
+campbell.png (modal.shroud of the case).
 
 Draws whatever the folder holds results for:
   modes.csv            -> nd_map.png        (frequency against nodal diameter)
@@ -32,10 +35,17 @@ PLOTS = [
 
 
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+    args = argv[1:]
+    shroud = None
+    if len(args) == 3 and args[1] == "--shroud" and args[2] in ("open", "stuck"):
+        shroud = args[2]
+        args = args[:1]
+    if len(args) != 1 or args[0] in ("-h", "--help"):
         print(__doc__, file=sys.stderr)
         return 2
-    result_dir = argv[1]
+    result_dir = args[0]
+    if shroud:
+        os.environ["SHROUDSIM_PLOT_SHROUD"] = shroud
     if not os.path.isdir(result_dir):
         print(f"plot.py: {result_dir}: no such result folder", file=sys.stderr)
         return 2

@@ -89,7 +89,7 @@ int cmd_campbell(Context& ctx) {
   std::sort(hs.begin(), hs.end());
   hs.erase(std::unique(hs.begin(), hs.end()), hs.end());
 
-  ModalModel model = run_modal_stage(ctx, hs, /*keep_factors=*/false);
+  ModalModel model = run_modal_stage(ctx, hs, /*keep_factors=*/false, 0.0, case_shroud(c));
   log::Stopwatch clock;
   write_modes_csv(ctx, model);
 

@@ -10,6 +10,8 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <numbers>
+#include <iomanip>
 #include <sstream>
 #include <thread>
 
@@ -20,6 +22,7 @@
 #include "core/log.hpp"
 #include "fe/assembly.hpp"
 #include "fe/fingerprint.hpp"
+#include "frf/contact_patches.hpp"
 #include "io/output.hpp"
 #include "modal/cache.hpp"
 #include "modal/harmonic.hpp"
@@ -62,10 +65,23 @@ std::string matrices_key(const mesh::Mesh& m, const fe::Material& mat) {
 // Speed 0 keeps the key of the modes at rest; a speed adds the rotating-effects tag and Omega.
 constexpr const char* kRotatingVersion = "rotating/1";
 
-std::string modes_key(const std::string& km_key, int h, const modal::ModalOptions& o, double speed_rpm) {
+constexpr const char* kInterfaceVersion = "interface/1";
+
+std::string modes_key(const std::string& km_key, int h, const modal::ModalOptions& o, double speed_rpm,
+                      const std::vector<cyclic::InterfaceSpring>& springs) {
   fe::Hasher hs;
   hs.add(std::string(kModesVersion));
   hs.add(km_key);
+  // The open shroud keeps the key it always had; springs add their nodes, frames, stiffnesses.
+  if (!springs.empty()) {
+    hs.add(std::string(kInterfaceVersion));
+    for (const auto& sp : springs) {
+      hs.add(sp.high_node);
+      hs.add(sp.low_node);
+      for (int i = 0; i < 9; ++i) hs.add(sp.frame(i));
+      for (int i = 0; i < 3; ++i) hs.add(sp.stiffness[i]);
+    }
+  }
   if (speed_rpm > 0.0) {
     hs.add(std::string(kRotatingVersion));
     hs.add(speed_rpm);
@@ -89,8 +105,35 @@ struct HarmonicOutcome {
 }  // namespace
 
 const cyclic::CyclicSector& ModalModel::cyclic() {
-  if (!cyclic_) cyclic_ = std::make_unique<cyclic::CyclicSector>(mesh, km);
+  if (!cyclic_) {
+    cyclic_ = std::make_unique<cyclic::CyclicSector>(mesh, km);
+    cyclic_->set_interface(interface);
+  }
   return *cyclic_;
+}
+
+Shroud case_shroud(const io::Case& c) { return c.modal.shroud == "stuck" ? Shroud::stuck : Shroud::open; }
+
+std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mesh::Mesh& mesh) {
+  const std::vector<frf::ShroudFaceNode> face = frf::shroud_face(mesh);
+  double area = 0.0;
+  for (const auto& f : face) area += f.area;
+  if (face.empty() || !(area > 0))
+    throw InputError(location(c, "modal.shroud") + ": modal.shroud = \"stuck\" needs matched shroud_high/shroud_low node pairs, and the mesh has none");
+  std::vector<cyclic::InterfaceSpring> springs;
+  springs.reserve(face.size());
+  const double angle = c.contact.frame_angle_deg * std::numbers::pi / 180.0;
+  for (const auto& f : face) {
+    cyclic::InterfaceSpring sp;
+    sp.high_node = f.high;
+    sp.low_node = f.low;
+    sp.frame = frf::contact_frame(f.normal, mesh.nodes.row(f.high).transpose(), angle);
+    const double share = f.area / area;
+    sp.stiffness = Eigen::Vector3d(c.contact.tangential_stiffness, c.contact.tangential_stiffness,
+                                   c.contact.normal_stiffness) * share;
+    springs.push_back(sp);
+  }
+  return springs;
 }
 
 modal::StiffnessFactor ModalModel::stiffness_factor(int h) {
@@ -121,7 +164,7 @@ std::vector<int> modal_harmonic_indices(const io::Case& c) {
 }
 
 ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors,
-                           double speed_rpm) {
+                           double speed_rpm, Shroud shroud) {
   const io::Case& c = ctx.config;
   ModalModel model;
   model.mesh = obtain_mesh(ctx);
@@ -141,6 +184,18 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   report["cache_dir"] = cache_dir.string();
   report["sectors"] = nb;
   report["modes_per_harmonic_index"] = model.options.modes;
+  if (shroud == Shroud::stuck) model.interface = shroud_springs(c, model.mesh);
+  report["shroud"] = shroud == Shroud::stuck ? "stuck" : "open";
+  if (shroud == Shroud::stuck) {
+    double kn = 0.0, kt = 0.0;
+    for (const auto& sp : model.interface) kt += sp.stiffness[0], kn += sp.stiffness[2];
+    report["shroud_springs"] = {{"pairs", model.interface.size()}, {"normal_stiffness_n_per_m", kn},
+                                {"tangential_stiffness_n_per_m", kt}};
+    std::ostringstream line;
+    line << "stuck shroud: " << model.interface.size() << " matched shroud pairs tied (kn " << std::setprecision(6) << kn
+         << " N/m, kt " << kt << " N/m over the face)";
+    log::info(line.str());
+  }
 
   // K and M.
   log::Stopwatch clock;
@@ -171,7 +226,8 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   if (speed_rpm > 0.0) {
     clock.restart();
     const double omega = modal::rpm_to_rad_s(speed_rpm);
-    const cyclic::CyclicSector rest(model.mesh, model.km);
+    cyclic::CyclicSector rest(model.mesh, model.km);
+    rest.set_interface(model.interface);  // a stuck shroud carries centrifugal load across
     const modal::RotatingOperators ops = modal::rotating_operators(model.mesh, model.material, model.km, rest);
     model.km.K = model.km.K + (omega * omega) * ops.rotating_stiffness();
     model.km.K.makeCompressed();
@@ -196,7 +252,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   std::map<int, HarmonicOutcome> outcome;
   std::vector<int> to_solve;
   for (int h : canonical) {
-    const fs::path f = cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm) + ".bin");
+    const fs::path f = cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm, model.interface) + ".bin");
     auto cached = modal::load_basis(f);
     if (cached && cached->harmonic_index == h && cached->size() == model.options.modes) {
       HarmonicOutcome& o = outcome[h];
@@ -275,7 +331,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     if (!r.message.empty()) ctx.report.warn("harmonic index " + std::to_string(h) + ": " + r.message);
     if (!o.reused) {
       try {
-        modal::save_basis(cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm) + ".bin"), o.result.basis);
+        modal::save_basis(cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm, model.interface) + ".bin"), o.result.basis);
       } catch (const std::exception& e) {
         ctx.report.warn(std::string("could not cache modes: ") + e.what());
       }
@@ -437,7 +493,9 @@ void draw_plots(Context& ctx) {
     ctx.report.section("plots")["drawn"] = false;
     return;
   }
-  const std::string cmd = std::string(python) + " '" + script.string() + "' '" + ctx.out_dir.string() + "'";
+  std::string cmd = std::string(python) + " '" + script.string() + "' '" + ctx.out_dir.string() + "'";
+  if (ctx.report.json().contains("modal") && ctx.report.json()["modal"].contains("shroud"))
+    cmd += " --shroud " + ctx.report.json()["modal"]["shroud"].get<std::string>();
   const int rc = std::system(cmd.c_str());
   ctx.report.section("plots")["drawn"] = rc == 0;
   if (rc != 0) ctx.report.warn("plotting failed (" + cmd + ")");
@@ -448,7 +506,7 @@ int cmd_modes(Context& ctx) {
   if (c.structure.type != "sector")
     throw InputError(location(c, "structure.type") + ": structure.type = \"" + c.structure.type +
                      "\": `modes` needs an FE sector (structure.type = \"sector\")");
-  ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), /*keep_factors=*/false);
+  ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), /*keep_factors=*/false, 0.0, case_shroud(c));
   write_modes_csv(ctx, model);
   if (!model.bases.empty()) write_modes_vtu(ctx, model);
   if (!model.failures.empty()) {

@@ -36,6 +36,8 @@ struct ModalModel {
   std::map<int, modal::ModalBasis> bases;     ///< per harmonic index (reduced DOFs of that h)
   std::map<int, modal::StiffnessFactor> factors;  ///< K_h factors kept from the solves (h with shift 0)
   std::vector<std::string> failures;          ///< harmonic indices whose modes failed (message each)
+  /// The stuck shroud's springs (empty: open shroud); every reduction of cyclic() has them.
+  std::vector<cyclic::InterfaceSpring> interface;
 
   /// The cyclic reduction of the sector (built on first use).
   const cyclic::CyclicSector& cyclic();
@@ -60,8 +62,21 @@ std::vector<int> modal_harmonic_indices(const io::Case& c);
 /// (centrifugal stiffening and spin softening, modal/rotating.hpp), so the modes, the
 /// cyclic reduction and the K_h factors (static and residual flexibility) are all those at
 /// that speed; the mode cache key then includes the speed. 0: the sector at rest.
+/// shroud: "open", or "stuck" for the case's modal.shroud = "stuck" (`modes`, `campbell`):
+/// every matched shroud pair tied by springs (shroud_springs), in the modes, the static solve
+/// of the prestress and the K_h factors; the cache keys include the springs.
+enum class Shroud { open, stuck };
 ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors = true,
-                           double speed_rpm = 0.0);
+                           double speed_rpm = 0.0, Shroud shroud = Shroud::open);
+
+/// The shroud state `modes` and `campbell` use: the case's modal.shroud.
+Shroud case_shroud(const io::Case& c);
+
+/// The stuck shroud's springs: one per matched shroud pair (frf::shroud_face), stiffness
+/// (kt, kt, kn) of contact.tangential_stiffness and normal_stiffness times a_i / A (the
+/// pair's share of the face area), in the pair's contact frame (frf::contact_frame, turned by
+/// contact.frame_angle_deg). Throws InputError when the mesh has no matched shroud pairs.
+std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mesh::Mesh& mesh);
 
 /// modes.csv: harmonic_index,nodal_diameter,mode,frequency_hz (mode numbered from 1).
 void write_modes_csv(Context& ctx, const ModalModel& model);

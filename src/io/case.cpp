@@ -442,6 +442,7 @@ void read_all(Reader& r, Case& c) {
   });
   mo.residual_flexibility = r.boolean("modal.residual_flexibility");
   mo.eigensolver = r.string("modal.eigensolver", {"block", "spectra"});
+  mo.shroud = r.string("modal.shroud", {"open", "stuck"});
 
   auto& ca = c.campbell;
   ca.speed_rpm = r.numbers("campbell.speed_rpm");

@@ -50,6 +50,7 @@ struct ModalSection {
   double damping_ratio = 0.001;
   bool residual_flexibility = true;
   std::string eigensolver = "block";    ///< "block" (block Krylov-Schur) | "spectra" (Spectra's Lanczos)
+  std::string shroud = "open";          ///< "open" | "stuck" (modes and campbell; docs/physics.md section 1)
 };
 
 struct CampbellSection {

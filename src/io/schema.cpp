@@ -56,6 +56,7 @@ const std::vector<KeySpec>& case_schema() {
       {"modal.harmonic_indices", "\"all\"", "\"all\" or a list of 0 <= h < sectors", "harmonic indices of the nodal diameter map"},
       {"modal.damping_ratio", "0.001", "0 <= ratio < 1", "modal damping ratio of every mode"},
       {"modal.residual_flexibility", "true", "true | false", "add the static flexibility of the truncated modes"},
+      {"modal.shroud", "\"open\"", "\"open\" | \"stuck\"", "shroud contact of `modes` and `campbell`: open (blades coupled through the disk only) or stuck (every matched shroud pair tied by contact.normal_stiffness and tangential_stiffness, shared by tributary area, in its contact frame); the forced response always starts from the open sector"},
       {"modal.eigensolver", "\"block\"", "\"block\" | \"spectra\"", "block Krylov-Schur (default, faster) or Spectra's Lanczos (2n embedding for complex h)"},
 
       {"campbell.speed_rpm", "[0.0, 15000.0]", "[min, max], 0 <= min < max", "speed range (rpm)"},

@@ -37,6 +37,12 @@ def _families(rows):
     return {nd: [f for _, f in sorted(v)] for nd, v in sorted(by_nd.items())}
 
 
+def _shroud_note():
+    """' (open shroud)' / ' (stuck shroud)' when plot.py was given --shroud."""
+    s = os.environ.get("SHROUDSIM_PLOT_SHROUD")
+    return f" ({s} shroud)" if s else ""
+
+
 def plot_nd_map(result_dir):
     fam = _families(_read_csv(os.path.join(result_dir, "modes.csv")))
     nds = sorted(fam)
@@ -54,7 +60,7 @@ def plot_nd_map(result_dir):
         ax.set_title("all %d mode families" % count if count == n_modes else "lowest %d mode families" % count)
         if count <= 10:
             ax.legend(fontsize=7, ncol=2)
-    fig.suptitle("Nodal diameter map")
+    fig.suptitle("Nodal diameter map" + _shroud_note())
     fig.tight_layout()
     fig.savefig(os.path.join(result_dir, "nd_map.png"), dpi=120)
     plt.close(fig)
@@ -115,8 +121,8 @@ def plot_campbell(result_dir):
     ax.set_xlabel("speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
     flat = all(max(f for _, f in pts) - min(f for _, f in pts) <= 1e-9 * max(f for _, f in pts) for pts in lines.values())
-    ax.set_title("Campbell diagram (frequencies independent of speed)" if flat else
-                 "Campbell diagram (centrifugal stiffening and spin softening)")
+    ax.set_title(("Campbell diagram (frequencies independent of speed)" if flat else
+                  "Campbell diagram (centrifugal stiffening and spin softening)") + _shroud_note())
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")
     fig.tight_layout()

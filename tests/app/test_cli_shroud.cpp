@@ -1,0 +1,116 @@
+// modal.shroud = "stuck" through the command line: the tied shroud couples the blades (the
+// ND map is no longer flat), its modes are cached apart from the open ones, and `campbell`
+// with rotating effects uses it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cli_runner.hpp"
+
+namespace shroudsim::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kCoarseCase = R"(name = "coarse"
+[geometry]
+element_order = 1
+mesh_size = 0.025
+[modal]
+modes = 6
+harmonic_indices = [0, 1, 4]
+[campbell]
+speed_rpm = [0.0, 6000.0]
+speed_points = 3
+engine_orders = [1, 8]
+rotating_effects = true
+)";
+
+// (h, mode) -> frequency [Hz] from modes.csv.
+std::map<std::pair<int, int>, double> modes_csv(const fs::path& file) {
+  std::map<std::pair<int, int>, double> f;
+  std::istringstream s(slurp(file));
+  std::string line;
+  std::getline(s, line);
+  EXPECT_EQ(line, "harmonic_index,nodal_diameter,mode,frequency_hz");
+  while (std::getline(s, line)) {
+    std::vector<std::string> c;
+    std::istringstream l(line);
+    for (std::string x; std::getline(l, x, ',');) c.push_back(x);
+    f[{std::stoi(c[0]), std::stoi(c[2])}] = std::stod(c[3]);
+  }
+  return f;
+}
+
+nlohmann::json run_json(const fs::path& dir) { return nlohmann::json::parse(slurp(dir / "run.json")); }
+
+TEST(CliShroud, StuckShroudCouplesTheBladesAndIsCachedApartFromTheOpenOne) {
+  Scratch s("shroud_modes");
+  s.write("coarse.toml", kCoarseCase);
+  ASSERT_EQ(s.run("modes coarse.toml --out open --quiet").status, 0);
+  const CliResult stuck = s.run("modes coarse.toml --set 'modal.shroud=\"stuck\"' --out stuck");
+  ASSERT_EQ(stuck.status, 0) << stuck.err;
+  EXPECT_NE(stuck.err.find("stuck shroud:"), std::string::npos) << stuck.err;
+  const auto open = modes_csv(s.dir() / "open" / "modes.csv");
+  const auto tied = modes_csv(s.dir() / "stuck" / "modes.csv");
+  ASSERT_EQ(open.size(), 18u);
+  ASSERT_EQ(tied.size(), 18u);
+  // Open: the blades couple only through the stiff disk, the first family is flat over ND
+  // (within 1 %). Stuck: the springs (1e6 N/m over the face) raise the ND 4 family by far
+  // more, and ND 0 (neighbours in phase) least.
+  EXPECT_LT(std::abs(open.at({4, 1}) / open.at({0, 1}) - 1.0), 0.01);
+  EXPECT_GT(tied.at({4, 1}), 1.5 * open.at({4, 1}));
+  EXPECT_LT(tied.at({0, 1}), tied.at({4, 1}));
+  for (const auto& [key, f] : open) EXPECT_GE(tied.at(key), f * (1.0 - 1e-9)) << key.first << " " << key.second;
+  EXPECT_EQ(run_json(s.dir() / "open")["modal"]["shroud"], "open");
+  const auto js = run_json(s.dir() / "stuck")["modal"];
+  EXPECT_EQ(js["shroud"], "stuck");
+  EXPECT_GT(js["shroud_springs"]["pairs"].get<int>(), 0);
+  EXPECT_NEAR(js["shroud_springs"]["normal_stiffness_n_per_m"].get<double>(), 1e6, 1e-6 * 1e6);
+
+  // Each state reuses its own cached modes, never the other's.
+  ASSERT_EQ(s.run("modes coarse.toml --out open2 --quiet").status, 0);
+  ASSERT_EQ(s.run("modes coarse.toml --set 'modal.shroud=\"stuck\"' --out stuck2 --quiet").status, 0);
+  EXPECT_EQ(slurp(s.dir() / "open2" / "modes.csv"), slurp(s.dir() / "open" / "modes.csv"));
+  EXPECT_EQ(slurp(s.dir() / "stuck2" / "modes.csv"), slurp(s.dir() / "stuck" / "modes.csv"));
+  for (const char* d : {"open2", "stuck2"})
+    for (const auto& e : run_json(s.dir() / d)["modal"]["solved"]) EXPECT_TRUE(e["reused"].get<bool>()) << d;
+}
+
+TEST(CliShroud, CampbellWithRotatingEffectsUsesTheStuckShroud) {
+  Scratch s("shroud_campbell");
+  s.write("coarse.toml", kCoarseCase);
+  ASSERT_EQ(s.run("modes coarse.toml --set 'modal.shroud=\"stuck\"' --out modes --quiet").status, 0);
+  const CliResult r = s.run("campbell coarse.toml --set 'modal.shroud=\"stuck\"' --out campbell --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  // At 0 rpm the Campbell's frequencies are the stuck modes at rest.
+  const auto rest = modes_csv(s.dir() / "modes" / "modes.csv");
+  std::istringstream c(slurp(s.dir() / "campbell" / "campbell.csv"));
+  std::string line;
+  std::getline(c, line);
+  int checked = 0;
+  while (std::getline(c, line)) {
+    std::vector<std::string> v;
+    std::istringstream l(line);
+    for (std::string x; std::getline(l, x, ',');) v.push_back(x);
+    if (std::stod(v[0]) != 0.0) continue;
+    EXPECT_NEAR(std::stod(v[4]), rest.at({std::stoi(v[1]), std::stoi(v[3])}), 1e-6 * std::stod(v[4]));
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+  EXPECT_EQ(run_json(s.dir() / "campbell")["modal"]["shroud"], "stuck");
+}
+
+TEST(CliShroud, BadShroudValueExitsTwoNamingTheKey) {
+  Scratch s("shroud_bad");
+  s.write("coarse.toml", kCoarseCase);
+  const CliResult r = s.run("modes coarse.toml --set 'modal.shroud=\"closed\"' --quiet");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("modal.shroud"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace shroudsim::testing
