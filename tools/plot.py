@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Plots of a shroudsim result folder (matplotlib).
 
-usage: tools/plot.py RESULT_DIR [--shroud open|stuck]
+usage: tools/plot.py RESULT_DIR [--shroud open|stuck|contact]
 
 --shroud names the shroud state of the modal model in the titles of nd_map.png and
 campbell.png (modal.shroud of the case).
@@ -9,6 +9,7 @@ campbell.png (modal.shroud of the case).
 Draws whatever the folder holds results for:
   modes.csv            -> nd_map.png        (frequency against nodal diameter)
   campbell.csv         -> campbell.png      (frequency against speed, engine orders, crossings)
+  static_contact.csv   -> contact_static.png (static shroud contact pressure and state over the face)
   contact.json         -> contact_loops.png (hysteresis loops of one contact pair)
   frf.csv              -> frf.png           (nonlinear and linear forced response)
   loops.csv            -> loops.png         (contact loops at the peak)
@@ -27,6 +28,7 @@ sys.path.insert(0, HERE)
 PLOTS = [
     ("modes.csv", "plotting.modal_plots", "plot_nd_map"),
     ("campbell.csv", "plotting.modal_plots", "plot_campbell"),
+    ("static_contact.csv", "plotting.modal_plots", "plot_static_contact"),
     ("contact.json", "plotting.contact_plots", "plot_contact"),
     ("frf.csv", "plotting.frf_plots", "plot_frf"),
     ("study.csv", "plotting.study_plots", "plot_study"),
@@ -37,7 +39,7 @@ PLOTS = [
 def main(argv):
     args = argv[1:]
     shroud = None
-    if len(args) == 3 and args[1] == "--shroud" and args[2] in ("open", "stuck"):
+    if len(args) == 3 and args[1] == "--shroud" and args[2] in ("open", "stuck", "contact"):
         shroud = args[2]
         args = args[:1]
     if len(args) != 1 or args[0] in ("-h", "--help"):

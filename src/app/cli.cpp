@@ -103,6 +103,7 @@ int run_cli(int argc, char** argv) {
       {"campbell", "frequencies against speed with engine-order lines -> campbell.csv, crossings.csv", cmd_campbell},
       {"frf", "nonlinear forced response with continuation -> frf.csv", cmd_frf},
       {"contact", "one contact pair under the prescribed motion of [motion] -> contact.json", cmd_contact},
+      {"static", "shroud contact of the spinning sector (interference, friction) -> static_contact.csv, contact_static.vtu", cmd_static},
       {"study", "the case over the [study] sweep -> one folder per point and study.csv", cmd_study},
   };
   std::vector<CommonOptions> options(subs.size());

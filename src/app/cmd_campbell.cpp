@@ -26,6 +26,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -37,6 +38,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
+#include "frf/static_shroud.hpp"
 #include "modal/rotating.hpp"
 
 namespace shroudsim::app {
@@ -123,7 +125,14 @@ int cmd_campbell(Context& ctx) {
     // Centrifugal prestress (h = 0 static solve) and the reduction of K_sigma1, M_spin.
     log::Stopwatch watch;
     const cyclic::CyclicSector& sector = model.cyclic();
-    const modal::RotatingOperators ops = modal::rotating_operators(model.mesh, model.material, model.km, sector);
+    // modal.shroud = "contact": the sweep's sector is open and each speed ties the pairs the
+    // static shroud contact closes there (docs/physics.md section 8); the prestress is that of
+    // the open sector.
+    const bool follow_contact = case_shroud(c) == Shroud::contact;
+    std::unique_ptr<cyclic::CyclicSector> open_sector;
+    if (follow_contact) open_sector = std::make_unique<cyclic::CyclicSector>(model.mesh, model.km);
+    const cyclic::CyclicSector& sweep_sector = follow_contact ? *open_sector : sector;
+    const modal::RotatingOperators ops = modal::rotating_operators(model.mesh, model.material, model.km, sweep_sector);
     const cyclic::CyclicSector rot(model.mesh, {ops.geometric, ops.spin});
     const double prestress_seconds = watch.seconds();
     const double omega_top = modal::rpm_to_rad_s(s1);
@@ -133,6 +142,44 @@ int cmd_campbell(Context& ctx) {
     report["peak_von_mises_pa_at_top_speed"] = peak_top;
     report["peak_von_mises_element"] = ops.peak.element;
     report["max_static_displacement_m_at_top_speed"] = tip_top;
+    // The static shroud contact at every speed, in increasing order (friction state carried),
+    // from rest (static.increments steps up to the first speed when it is not 0).
+    std::vector<std::vector<bool>> closed_at(np);
+    std::vector<cyclic::InterfaceSpring> all_springs;
+    int static_points = np;
+    if (follow_contact) {
+      log::Stopwatch static_clock;
+      all_springs = shroud_springs(c, model.mesh);
+      frf::StaticShroudSolver solver(model.mesh, model.km, &ops, static_shroud_settings(c, 0.0));
+      nlohmann::json states = nlohmann::json::array();
+      try {
+        const int pre = rpm[0] > 0.0 ? std::max(1, c.static_contact.increments) : 0;
+        for (int k = 1; k <= pre; ++k)
+          solver.step_to(modal::rpm_to_rad_s(rpm[0]) * std::sqrt(static_cast<double>(k) / (pre + 1)));
+        for (int i = 0; i < np; ++i) {
+          solver.step_to(modal::rpm_to_rad_s(rpm[i]));
+          const frf::StaticShroud& st = solver.state();
+          closed_at[i].resize(st.results.size());
+          int closed = 0;
+          for (std::size_t p = 0; p < st.results.size(); ++p) {
+            closed_at[i][p] = st.results[p].state != contact::StaticState::open;
+            closed += closed_at[i][p] ? 1 : 0;
+          }
+          states.push_back({{"speed_rpm", rpm[i]}, {"closed", closed}, {"open", static_cast<int>(st.results.size()) - closed},
+                            {"slip", st.count(contact::StaticState::slip)}, {"normal_load_n", st.normal_load()}});
+        }
+      } catch (const NumericalError& e) {
+        static_points = static_cast<int>(states.size());
+        model.failures.push_back(std::string("static shroud contact: ") + e.what());
+      }
+      report["shroud_contact"] = {{"states", states}, {"seconds", static_clock.seconds()},
+                                  {"interference_m", c.contact.interference}};
+      const int closed_top = static_points > 0 ? states.back()["closed"].get<int>() : 0;
+      log::info("campbell: static shroud contact at " + std::to_string(static_points) + " speeds: " +
+                std::to_string(closed_top) + " of " + std::to_string(all_springs.size()) + " pairs closed at " +
+                io::format_number(static_points > 0 ? rpm[static_points - 1] : 0.0) + " rpm (" +
+                fixed(static_clock.seconds(), 2) + " s)");
+    }
     {
       // The prestress at the top speed for ParaView: displacement and nodal von Mises stress.
       const double w2 = omega_top * omega_top;
@@ -154,14 +201,22 @@ int cmd_campbell(Context& ctx) {
         Sweep s;
         s.f.assign(np, Eigen::VectorXd());
         try {
-          modal::RotatingHarmonic hr(sector, rot, h);
+          modal::RotatingHarmonic hr(sweep_sector, rot, h);
+          if (follow_contact) hr.set_variable_springs(sweep_sector, all_springs);
           for (int i = 0; i < np; ++i) {
-            if (rpm[i] == 0.0) {  // K(0) = K: the modes at rest
+            if (rpm[i] == 0.0 && !follow_contact) {  // K(0) = K: the modes at rest
               s.f[i] = at_rest(h);
               continue;
             }
+            if (follow_contact && i >= static_points) {
+              s.failure = "harmonic index " + std::to_string(h) + ": no static shroud contact state at " +
+                          io::format_number(rpm[i]) + " rpm";
+              break;
+            }
             log::Stopwatch solve_clock;
-            const modal::ModalResult r = hr.solve(modal::rpm_to_rad_s(rpm[i]), model.options);
+            const modal::ModalResult r = follow_contact
+                                             ? hr.solve(modal::rpm_to_rad_s(rpm[i]), model.options, closed_at[i])
+                                             : hr.solve(modal::rpm_to_rad_s(rpm[i]), model.options);
             s.seconds += solve_clock.seconds();
             s.factor_seconds += r.report.factor_seconds;
             s.lanczos_seconds += r.report.solve_seconds;

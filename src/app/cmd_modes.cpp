@@ -112,14 +112,16 @@ const cyclic::CyclicSector& ModalModel::cyclic() {
   return *cyclic_;
 }
 
-Shroud case_shroud(const io::Case& c) { return c.modal.shroud == "stuck" ? Shroud::stuck : Shroud::open; }
+Shroud case_shroud(const io::Case& c) {
+  return c.modal.shroud == "stuck" ? Shroud::stuck : c.modal.shroud == "contact" ? Shroud::contact : Shroud::open;
+}
 
 std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mesh::Mesh& mesh) {
   const std::vector<frf::ShroudFaceNode> face = frf::shroud_face(mesh);
   double area = 0.0;
   for (const auto& f : face) area += f.area;
   if (face.empty() || !(area > 0))
-    throw InputError(location(c, "modal.shroud") + ": modal.shroud = \"stuck\" needs matched shroud_high/shroud_low node pairs, and the mesh has none");
+    throw InputError(location(c, "modal.shroud") + ": modal.shroud = \"" + c.modal.shroud + "\" needs matched shroud_high/shroud_low node pairs, and the mesh has none");
   std::vector<cyclic::InterfaceSpring> springs;
   springs.reserve(face.size());
   const double angle = c.contact.frame_angle_deg * std::numbers::pi / 180.0;
@@ -184,18 +186,8 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   report["cache_dir"] = cache_dir.string();
   report["sectors"] = nb;
   report["modes_per_harmonic_index"] = model.options.modes;
-  if (shroud == Shroud::stuck) model.interface = shroud_springs(c, model.mesh);
-  report["shroud"] = shroud == Shroud::stuck ? "stuck" : "open";
-  if (shroud == Shroud::stuck) {
-    double kn = 0.0, kt = 0.0;
-    for (const auto& sp : model.interface) kt += sp.stiffness[0], kn += sp.stiffness[2];
-    report["shroud_springs"] = {{"pairs", model.interface.size()}, {"normal_stiffness_n_per_m", kn},
-                                {"tangential_stiffness_n_per_m", kt}};
-    std::ostringstream line;
-    line << "stuck shroud: " << model.interface.size() << " matched shroud pairs tied (kn " << std::setprecision(6) << kn
-         << " N/m, kt " << kt << " N/m over the face)";
-    log::info(line.str());
-  }
+  report["shroud"] = shroud == Shroud::stuck ? "stuck" : shroud == Shroud::contact ? "contact" : "open";
+  if (shroud != Shroud::open) model.interface = shroud_springs(c, model.mesh);
 
   // K and M.
   log::Stopwatch clock;
@@ -220,6 +212,27 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
                         {"dofs", model.mesh.n_dofs()}, {"stored_entries_K", model.km.K.nonZeros()}};
   log::info(std::string(km_reused ? "reused" : "assembled") + " K and M: " + std::to_string(model.mesh.n_dofs()) +
             " DOFs, " + std::to_string(model.km.K.nonZeros()) + " stored entries (" + fixed(km_seconds, 2) + " s)");
+
+  if (shroud == Shroud::contact) {
+    // The pairs the interference closes at rest (campbell follows the state with speed).
+    const frf::StaticShroud st = frf::solve_static_shroud(model.mesh, model.km, nullptr, static_shroud_settings(c, 0.0));
+    std::vector<cyclic::InterfaceSpring> closed;
+    for (std::size_t i = 0; i < st.results.size(); ++i)
+      if (st.results[i].state != contact::StaticState::open) closed.push_back(model.interface[i]);
+    report["shroud_contact_at_rest"] = {{"closed", closed.size()}, {"open", st.results.size() - closed.size()},
+                                        {"normal_load_n", st.normal_load()}};
+    model.interface = std::move(closed);
+  }
+  if (shroud != Shroud::open) {
+    double kn = 0.0, kt = 0.0;
+    for (const auto& sp : model.interface) kt += sp.stiffness[0], kn += sp.stiffness[2];
+    report["shroud_springs"] = {{"pairs", model.interface.size()}, {"normal_stiffness_n_per_m", kn},
+                                {"tangential_stiffness_n_per_m", kt}};
+    std::ostringstream line;
+    line << "shroud " << report["shroud"].get<std::string>() << ": " << model.interface.size()
+         << " matched shroud pairs tied (kn " << std::setprecision(6) << kn << " N/m, kt " << kt << " N/m)";
+    log::info(line.str());
+  }
 
   // Spinning sector: K -> K + Omega^2 (K_sigma1 - M_spin), prestress from the h = 0 static solve.
   model.speed_rpm = speed_rpm;

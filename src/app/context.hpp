@@ -45,6 +45,7 @@ int cmd_modes(Context& ctx);
 int cmd_campbell(Context& ctx);
 int cmd_frf(Context& ctx);
 int cmd_contact(Context& ctx);
+int cmd_static(Context& ctx);
 int cmd_study(Context& ctx);
 /// Every stage the case asks for, in order.
 int cmd_run(Context& ctx);

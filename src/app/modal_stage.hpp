@@ -22,6 +22,7 @@
 #include "app/context.hpp"
 #include "cyclic/cyclic_sector.hpp"
 #include "fe/tet_element.hpp"
+#include "frf/static_shroud.hpp"
 #include "linalg/sparse.hpp"
 #include "modal/eigensolver.hpp"
 
@@ -65,7 +66,8 @@ std::vector<int> modal_harmonic_indices(const io::Case& c);
 /// shroud: "open", or "stuck" for the case's modal.shroud = "stuck" (`modes`, `campbell`):
 /// every matched shroud pair tied by springs (shroud_springs), in the modes, the static solve
 /// of the prestress and the K_h factors; the cache keys include the springs.
-enum class Shroud { open, stuck };
+/// "contact": the pairs the static shroud contact at rest closes (contact.interference) tied.
+enum class Shroud { open, stuck, contact };
 ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors = true,
                            double speed_rpm = 0.0, Shroud shroud = Shroud::open);
 
@@ -77,6 +79,9 @@ Shroud case_shroud(const io::Case& c);
 /// pair's share of the face area), in the pair's contact frame (frf::contact_frame, turned by
 /// contact.frame_angle_deg). Throws InputError when the mesh has no matched shroud pairs.
 std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mesh::Mesh& mesh);
+
+/// The static shroud contact settings of the case at `speed_rpm` (contact.*, static.*).
+frf::StaticShroudSettings static_shroud_settings(const io::Case& c, double speed_rpm);
 
 /// modes.csv: harmonic_index,nodal_diameter,mode,frequency_hz (mode numbered from 1).
 void write_modes_csv(Context& ctx, const ModalModel& model);

@@ -128,13 +128,13 @@ void CyclicSector::set_interface(std::vector<InterfaceSpring> springs) {
   springs_ = std::move(springs);
 }
 
-SparseMatrixC CyclicSector::interface_rows(int h) const {
+SparseMatrixC CyclicSector::interface_rows(int h, const std::vector<InterfaceSpring>& springs) const {
   const Complex e = phase(h);
   const Eigen::Matrix3d R = rotation_z(2.0 * std::numbers::pi / sectors_);
   std::vector<Eigen::Triplet<Complex>> t;
-  t.reserve(springs_.size() * 18);
-  for (std::size_t i = 0; i < springs_.size(); ++i) {
-    const InterfaceSpring& s = springs_[i];
+  t.reserve(springs.size() * 18);
+  for (std::size_t i = 0; i < springs.size(); ++i) {
+    const InterfaceSpring& s = springs[i];
     const Eigen::Matrix3d LR = s.frame * R;
     for (int a = 0; a < 3; ++a) {
       const int row = static_cast<int>(3 * i) + a;
@@ -144,7 +144,7 @@ SparseMatrixC CyclicSector::interface_rows(int h) const {
       }
     }
   }
-  SparseMatrixC S(static_cast<Eigen::Index>(3 * springs_.size()), n_full_);
+  SparseMatrixC S(static_cast<Eigen::Index>(3 * springs.size()), n_full_);
   S.setFromTriplets(t.begin(), t.end());  // a spring from a node to itself sums its entries
   return S;
 }

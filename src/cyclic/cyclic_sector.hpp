@@ -78,7 +78,9 @@ class CyclicSector {
   const std::vector<InterfaceSpring>& interface() const { return springs_; }
   /// S_h: the relative displacements of the springs (3 rows per spring, row 3i + a is
   /// L_i(a, :) (u_q - exp(i h alpha) R u_p)) from all n_full sector DOFs.
-  linalg::SparseMatrixC interface_rows(int h) const;
+  linalg::SparseMatrixC interface_rows(int h) const { return interface_rows(h, springs_); }
+  /// The same for any springs (their stiffness is not used).
+  linalg::SparseMatrixC interface_rows(int h, const std::vector<InterfaceSpring>& springs) const;
 
   /// T_h: n_full x n_reduced (complex; real-valued for is_real(h)).
   linalg::SparseMatrixC expansion(int h) const;

@@ -442,7 +442,7 @@ void read_all(Reader& r, Case& c) {
   });
   mo.residual_flexibility = r.boolean("modal.residual_flexibility");
   mo.eigensolver = r.string("modal.eigensolver", {"block", "spectra"});
-  mo.shroud = r.string("modal.shroud", {"open", "stuck"});
+  mo.shroud = r.string("modal.shroud", {"open", "stuck", "contact"});
 
   auto& ca = c.campbell;
   ca.speed_rpm = r.numbers("campbell.speed_rpm");
@@ -453,6 +453,9 @@ void read_all(Reader& r, Case& c) {
   for (int e : ca.engine_orders)
     if (e < 1) r.violates("campbell.engine_orders", r.node("campbell.engine_orders"), "engine orders >= 1");
   ca.rotating_effects = r.boolean("campbell.rotating_effects");
+
+  c.static_contact.speed_rpm = r.number("static.speed_rpm", non_negative);
+  c.static_contact.increments = r.integer("static.increments", in_range_int(1, 1000));
 
   auto& ex = c.excitation;
   ex.engine_order = r.integer("excitation.engine_order", in_range_int(0, 100000));
@@ -494,6 +497,7 @@ void read_all(Reader& r, Case& c) {
   co.tangential_stiffness = r.number("contact.tangential_stiffness", positive);
   co.normal_preload = r.number("contact.normal_preload");
   co.frame_angle_deg = r.number("contact.frame_angle_deg");
+  co.interference = r.number("contact.interference");
   co.tangential_update = r.string("contact.tangential_update", {"exact_linear", "radial_return"});
   read_contact_elements(r, c);
   if (!lumped && !co.elements.empty())

@@ -50,7 +50,7 @@ struct ModalSection {
   double damping_ratio = 0.001;
   bool residual_flexibility = true;
   std::string eigensolver = "block";    ///< "block" (block Krylov-Schur) | "spectra" (Spectra's Lanczos)
-  std::string shroud = "open";          ///< "open" | "stuck" (modes and campbell; docs/physics.md section 1)
+  std::string shroud = "open";          ///< "open" | "stuck" | "contact" (modes and campbell; docs/physics.md sections 1, 8)
 };
 
 struct CampbellSection {
@@ -58,6 +58,11 @@ struct CampbellSection {
   int speed_points = 31;
   std::vector<int> engine_orders{1, 2, 3, 4, 5, 6};
   bool rotating_effects = false;
+};
+
+struct StaticSection {
+  double speed_rpm = 0.0;
+  int increments = 10;
 };
 
 struct ExcitationSection {
@@ -90,6 +95,7 @@ struct ContactSection {
   double tangential_stiffness = 1.0e6;   ///< N/m per interface
   double normal_preload = 0.25;          ///< N per interface, < 0: gap
   double frame_angle_deg = 0.0;
+  double interference = 0.0;            ///< sector: overlap of the shroud faces at rest [m]; < 0: a gap
   std::string tangential_update = "exact_linear";  ///< or "radial_return"
   std::vector<ContactElement> elements;  ///< lumped only
 };
@@ -139,6 +145,7 @@ struct Case {
   MaterialSection material;
   ModalSection modal;
   CampbellSection campbell;
+  StaticSection static_contact;          ///< [static]
   ExcitationSection excitation;
   ResponseSection response;
   ContactSection contact;

@@ -12,6 +12,7 @@ const std::vector<std::pair<std::string, std::string>>& case_sections() {
       {"material", "isotropic linear elastic material (SI)"},
       {"modal", "cyclic-symmetry modal analysis"},
       {"campbell", "Campbell diagram"},
+      {"static", "only for `shroudsim static`: the shroud contact of the spinning sector (interference, friction)"},
       {"excitation", "travelling-wave excitation"},
       {"response", "where the response amplitude is reported"},
       {"contact", "shroud friction contact"},
@@ -56,13 +57,16 @@ const std::vector<KeySpec>& case_schema() {
       {"modal.harmonic_indices", "\"all\"", "\"all\" or a list of 0 <= h < sectors", "harmonic indices of the nodal diameter map"},
       {"modal.damping_ratio", "0.001", "0 <= ratio < 1", "modal damping ratio of every mode"},
       {"modal.residual_flexibility", "true", "true | false", "add the static flexibility of the truncated modes"},
-      {"modal.shroud", "\"open\"", "\"open\" | \"stuck\"", "shroud contact of `modes` and `campbell`: open (blades coupled through the disk only) or stuck (every matched shroud pair tied by contact.normal_stiffness and tangential_stiffness, shared by tributary area, in its contact frame); the forced response always starts from the open sector"},
+      {"modal.shroud", "\"open\"", "\"open\" | \"stuck\" | \"contact\"", "shroud contact of `modes` and `campbell`: open (blades coupled through the disk only), stuck (every matched shroud pair tied by contact.normal_stiffness and tangential_stiffness, shared by tributary area, in its contact frame) or contact (the pairs the static shroud contact closes, with contact.interference, tied; at each speed of a Campbell diagram with rotating effects); the forced response always starts from the open sector"},
       {"modal.eigensolver", "\"block\"", "\"block\" | \"spectra\"", "block Krylov-Schur (default, faster) or Spectra's Lanczos (2n embedding for complex h)"},
 
       {"campbell.speed_rpm", "[0.0, 15000.0]", "[min, max], 0 <= min < max", "speed range (rpm)"},
       {"campbell.speed_points", "31", "2 <= points <= 10000", "speeds in the range"},
       {"campbell.engine_orders", "[1, 2, 3, 4, 5, 6]", "list of integers >= 1", "engine-order lines drawn and crossed"},
       {"campbell.rotating_effects", "false", "true | false", "centrifugal stiffening and spin softening"},
+
+      {"static.speed_rpm", "0.0", ">= 0", "rotor speed of the static shroud contact (rpm)"},
+      {"static.increments", "10", "1 <= increments <= 1000", "equal steps of speed^2 from rest to static.speed_rpm (the friction state is carried from step to step)"},
 
       {"excitation.engine_order", "1", ">= 0", "engine order m: harmonic n lives in harmonic index n*m mod Nb"},
       {"excitation.point", "[0.0, 0.35, 0.0]", "3 numbers (m)", "sector: the force acts at the nearest node"},
@@ -80,6 +84,7 @@ const std::vector<KeySpec>& case_schema() {
       {"contact.normal_stiffness", "1.0e6", "> 0", "normal contact stiffness per interface (N/m), shared over pairs by tributary area"},
       {"contact.tangential_stiffness", "1.0e6", "> 0", "tangential contact stiffness per interface (N/m)"},
       {"contact.normal_preload", "0.25", "any; < 0 means an initial gap -N0/kn", "normal preload per interface (N)"},
+      {"contact.interference", "0.0", "any (m); < 0: a gap", "sector: overlap of the shroud faces at rest, uniform over the face (m), for the static shroud contact (`static`)"},
       {"contact.frame_angle_deg", "0.0", "any", "turns the tangential axes t1, t2 about the normal (deg)"},
       {"contact.tangential_update", "\"exact_linear\"", "\"exact_linear\" | \"radial_return\"", "time integration of the coupled tangential law"},
       {"contact.elements", "[]", "array of tables (lumped only)", "lumped contact elements: x_dof, y_dof, z_dof, other_x_dof, ... and per-element overrides"},

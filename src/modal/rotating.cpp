@@ -104,4 +104,34 @@ ModalResult RotatingHarmonic::solve(double omega, const ModalOptions& options) {
   return solve_modes(complex_pair_, h_, options, reuse_);
 }
 
+void RotatingHarmonic::set_variable_springs(const cyclic::CyclicSector& sector,
+                                            const std::vector<cyclic::InterfaceSpring>& springs) {
+  y_ = sector.interface_rows(h_, springs) * sector.expansion(h_);
+  spring_k_.resize(y_.rows());
+  for (std::size_t i = 0; i < springs.size(); ++i) spring_k_.segment<3>(static_cast<Eigen::Index>(3 * i)) = springs[i].stiffness;
+}
+
+ModalResult RotatingHarmonic::solve(double omega, const ModalOptions& options, const std::vector<bool>& closed) {
+  SHROUDSIM_CHECK(static_cast<Eigen::Index>(3 * closed.size()) == y_.rows(),
+                  "RotatingHarmonic::solve: one closed flag per variable spring");
+  Eigen::VectorXcd k(y_.rows());
+  for (Eigen::Index r = 0; r < y_.rows(); ++r) k[r] = closed[static_cast<std::size_t>(r / 3)] ? spring_k_[r] : 0.0;
+  // diag(k) Y keeps Y's pattern (explicit zeros for open springs): a fixed pattern.
+  SparseMatrixC kY = y_;
+  for (Eigen::Index col = 0; col < kY.outerSize(); ++col)
+    for (SparseMatrixC::InnerIterator it(kY, col); it; ++it) it.valueRef() *= k[it.row()];
+  SparseMatrixC S = SparseMatrixC(y_.adjoint()) * kY;
+  const SparseMatrixC SH = S.adjoint();
+  S = 0.5 * (S + SH);
+  const double w2 = omega * omega;
+  if (real_) {
+    real_pair_.K = real_k0_ + w2 * real_d_ + SparseMatrixD(S.real());
+    real_pair_.K.makeCompressed();
+    return solve_modes(real_pair_, h_, options, reuse_);
+  }
+  complex_pair_.K = complex_k0_ + Complex(w2) * complex_d_ + S;
+  complex_pair_.K.makeCompressed();
+  return solve_modes(complex_pair_, h_, options, reuse_);
+}
+
 }  // namespace shroudsim::modal

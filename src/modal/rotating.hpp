@@ -63,6 +63,12 @@ class RotatingHarmonic {
   RotatingHarmonic(const cyclic::CyclicSector& sector, const cyclic::CyclicSector& rotating, int harmonic_index);
   /// Lowest options.modes modes of (K_h + omega^2 D_h) phi = w^2 M_h phi (no StiffnessFactor).
   ModalResult solve(double omega, const ModalOptions& options);
+  /// Springs whose state changes with speed (shroud pairs closed or open at each speed):
+  /// solve(omega, options, closed) adds Y_h^H diag(k) Y_h over the springs with closed[i]
+  /// (Y_h = sector.interface_rows(h, springs) T_h). The pattern keeps every spring, so the
+  /// symbolic analysis is still reused.
+  void set_variable_springs(const cyclic::CyclicSector& sector, const std::vector<cyclic::InterfaceSpring>& springs);
+  ModalResult solve(double omega, const ModalOptions& options, const std::vector<bool>& closed);
   int harmonic_index() const { return h_; }
   const FactorReuse& reuse() const { return reuse_; }
 
@@ -73,6 +79,8 @@ class RotatingHarmonic {
   linalg::SparseMatrixD real_k0_, real_d_;
   linalg::SparsePair<Complex> complex_pair_;
   linalg::SparseMatrixC complex_k0_, complex_d_;
+  linalg::SparseMatrixC y_;            // Y_h (3 rows per variable spring), empty without
+  Eigen::VectorXd spring_k_;           // stiffness of each row of Y_h
   FactorReuse reuse_;
 };
 

@@ -3,6 +3,7 @@
 
 plot_nd_map(result_dir):   modes.csv                     -> nd_map.png
 plot_campbell(result_dir): campbell.csv, crossings.csv   -> campbell.png
+plot_static_contact(result_dir): static_contact.csv     -> contact_static.png
 
 nd_map.png: natural frequency against nodal diameter, one line per mode family (the r-th
 mode of every nodal diameter), left all families, right the lowest ten.
@@ -12,6 +13,7 @@ meets a mode of the nodal diameter it excites.
 """
 import csv
 import json
+import math
 import os
 
 import matplotlib
@@ -40,6 +42,8 @@ def _families(rows):
 def _shroud_note():
     """' (open shroud)' / ' (stuck shroud)' when plot.py was given --shroud."""
     s = os.environ.get("SHROUDSIM_PLOT_SHROUD")
+    if s == "contact":
+        return " (shroud pairs closed by the static contact tied)"
     return f" ({s} shroud)" if s else ""
 
 
@@ -138,3 +142,39 @@ if __name__ == "__main__":
             plot_nd_map(d)
         if os.path.exists(os.path.join(d, "campbell.csv")):
             plot_campbell(d)
+
+
+def plot_static_contact(result_dir):
+    """contact_static.png: contact pressure and state of every shroud pair over the face
+    (axial z against radius r of the shroud_high node), from static_contact.csv."""
+    rows = _read_csv(os.path.join(result_dir, "static_contact.csv"))
+    if not rows:
+        return
+    z = [1e3 * float(r["z_m"]) for r in rows]
+    rad = [1e3 * math.hypot(float(r["x_m"]), float(r["y_m"])) for r in rows]
+    p = [float(r["pressure_pa"]) / 1e6 for r in rows]
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    markers = {"open": "x", "stick": "o", "slip": "s"}
+    sc = None
+    for state, marker in markers.items():
+        idx = [i for i, r in enumerate(rows) if r["state"] == state]
+        if not idx:
+            continue
+        if state == "open":
+            ax.scatter([z[i] for i in idx], [rad[i] for i in idx], c="0.5", marker=marker, s=30,
+                       label=f"open ({len(idx)})")
+        else:
+            sc = ax.scatter([z[i] for i in idx], [rad[i] for i in idx], c=[p[i] for i in idx], cmap="viridis",
+                            vmin=0.0, vmax=max(max(p), 1e-12), marker=marker, s=40, edgecolors="k",
+                            linewidths=0.3, label=f"{state} ({len(idx)})")
+    if sc is not None:
+        fig.colorbar(sc, ax=ax, label="contact pressure [MPa]")
+    total = sum(float(r["normal_load_n"]) for r in rows)
+    ax.set_xlabel("axial position z [mm]")
+    ax.set_ylabel("radius [mm]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right")
+    ax.set_title("Static shroud contact: %d pairs, normal load %.4g N" % (len(rows), total))
+    fig.tight_layout()
+    fig.savefig(os.path.join(result_dir, "contact_static.png"), dpi=120)
+    plt.close(fig)
