@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <numbers>
 #include <set>
 #include <tuple>
@@ -18,6 +20,8 @@
 #include "io/output.hpp"
 #include "frf/contact_patches.hpp"
 #include "frf/sector.hpp"
+#include "frf/static_shroud.hpp"
+#include "modal/rotating.hpp"
 
 namespace shroudsim::app {
 namespace {
@@ -38,6 +42,17 @@ ForcedModel make_sector_model(Context& ctx) {
   const int nb = c.structure.sectors, m = c.excitation.engine_order;
   std::set<int> needed;
   for (int n = 1; n <= c.hbm.harmonics; ++n) needed.insert(((n * m) % nb + nb) % nb);
+  // contact.normal_preload = "static": the static shroud contact at the forced response's
+  // speed, on the sector at rest plus its rotating operators (docs/physics.md section 8).
+  std::optional<frf::StaticShroud> static_state;
+  if (c.contact.normal_preload_static) {
+    ModalModel rest = run_modal_stage(ctx, {}, /*keep_factors=*/false);
+    std::unique_ptr<modal::RotatingOperators> ops;
+    if (c.excitation.speed_rpm > 0.0)
+      ops = std::make_unique<modal::RotatingOperators>(
+          modal::rotating_operators(rest.mesh, rest.material, rest.km, rest.cyclic()));
+    static_state = frf::solve_static_shroud(rest.mesh, rest.km, ops.get(), static_shroud_settings(c, c.excitation.speed_rpm));
+  }
   ModalModel modal = run_modal_stage(ctx, std::vector<int>(needed.begin(), needed.end()), /*keep_factors=*/true,
                                      c.excitation.speed_rpm);  // > 0: the modes at that speed
   if (!modal.failures.empty()) throw NumericalError("modal stage failed: " + modal.failures.front());
@@ -59,6 +74,7 @@ ForcedModel make_sector_model(Context& ctx) {
   double total = 0.0;
   for (const auto& f : face) total += f.area;
   ForcedModel model;
+  double static_preload = 0.0;
   for (const auto& p : patches) {
     const double s = p.area / total;
     contact::PairParameters pp;
@@ -66,6 +82,19 @@ ForcedModel make_sector_model(Context& ctx) {
     pp.tangential_stiffness = c.contact.tangential_stiffness * s;
     pp.normal_stiffness = c.contact.normal_stiffness * s;
     pp.normal_preload = c.contact.normal_preload * s;
+    if (static_state) {
+      // The patch's preload is the sum over its node pairs of their static normal loads, an
+      // open pair counting as -kn_i gap_i (so that a fully open patch has the area-weighted
+      // mean gap). The face and the static solve list the node pairs in the same order.
+      pp.normal_preload = 0.0;
+      for (int member : p.members) {
+        const auto& r = static_state->results[static_cast<std::size_t>(member)];
+        pp.normal_preload += r.state == contact::StaticState::open
+                                 ? -static_state->parameters[static_cast<std::size_t>(member)].normal_stiffness * r.gap
+                                 : r.force[2];
+      }
+      static_preload += pp.normal_preload;
+    }
     model.pairs.push_back(pp);
   }
   frf::SectorForcing forcing;
@@ -104,6 +133,16 @@ ForcedModel make_sector_model(Context& ctx) {
   j["contact_discretization"] = c.contact.discretization;
   j["shroud_pairs_available"] = face.size();
   j["contact_area_m2"] = total;
+  if (static_state) {
+    j["normal_preload_from"] = "static";
+    j["static_normal_load_n"] = static_state->normal_load();
+    j["static_open_pairs"] = static_state->count(contact::StaticState::open);
+    j["normal_preload_total_n"] = static_preload;
+    log::info("frf: preloads from the static shroud contact at " + io::format_number(c.excitation.speed_rpm) +
+              " rpm: normal load " + io::format_number(static_state->normal_load()) + " N, " +
+              std::to_string(static_state->count(contact::StaticState::open)) + " of " +
+              std::to_string(static_state->results.size()) + " pairs open");
+  }
   j["excitation_node"] = forcing.excitation_node;
   j["response_node"] = forcing.response_node;
   j["harmonic_indices"] = std::vector<int>(needed.begin(), needed.end());

@@ -495,7 +495,18 @@ void read_all(Reader& r, Case& c) {
   co.friction_coefficient = r.number("contact.friction_coefficient", non_negative);
   co.normal_stiffness = r.number("contact.normal_stiffness", positive);
   co.tangential_stiffness = r.number("contact.tangential_stiffness", positive);
-  co.normal_preload = r.number("contact.normal_preload");
+  {
+    const std::string key = "contact.normal_preload";
+    const toml::node& n = r.node(key);
+    if (auto sv = n.as_string()) {
+      if (sv->get() != "static") r.violates(key, n, "a number (N) or \"static\"");
+      if (lumped) r.violates(key, n, "a number (N): \"static\" needs an FE sector");
+      co.normal_preload_static = true;
+      co.normal_preload = 0.0;
+    } else {
+      co.normal_preload = r.number(key);
+    }
+  }
   co.frame_angle_deg = r.number("contact.frame_angle_deg");
   co.interference = r.number("contact.interference");
   co.tangential_update = r.string("contact.tangential_update", {"exact_linear", "radial_return"});

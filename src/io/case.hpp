@@ -94,6 +94,7 @@ struct ContactSection {
   double normal_stiffness = 1.0e6;       ///< N/m per interface
   double tangential_stiffness = 1.0e6;   ///< N/m per interface
   double normal_preload = 0.25;          ///< N per interface, < 0: gap
+  bool normal_preload_static = false;    ///< "static": each patch's from the static shroud contact at excitation.speed_rpm
   double frame_angle_deg = 0.0;
   double interference = 0.0;            ///< sector: overlap of the shroud faces at rest [m]; < 0: a gap
   std::string tangential_update = "exact_linear";  ///< or "radial_return"

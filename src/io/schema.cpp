@@ -83,7 +83,7 @@ const std::vector<KeySpec>& case_schema() {
       {"contact.friction_coefficient", "0.3", ">= 0", "Coulomb friction coefficient mu"},
       {"contact.normal_stiffness", "1.0e6", "> 0", "normal contact stiffness per interface (N/m), shared over pairs by tributary area"},
       {"contact.tangential_stiffness", "1.0e6", "> 0", "tangential contact stiffness per interface (N/m)"},
-      {"contact.normal_preload", "0.25", "any; < 0 means an initial gap -N0/kn", "normal preload per interface (N)"},
+      {"contact.normal_preload", "0.25", "any; < 0 means an initial gap -N0/kn; or \"static\" (sector)", "normal preload per interface (N); \"static\": each contact patch's normal load (or gap) from the static shroud contact at excitation.speed_rpm (contact.interference, `shroudsim static`)"},
       {"contact.interference", "0.0", "any (m); < 0: a gap", "sector: overlap of the shroud faces at rest, uniform over the face (m), for the static shroud contact (`static`)"},
       {"contact.frame_angle_deg", "0.0", "any", "turns the tangential axes t1, t2 about the normal (deg)"},
       {"contact.tangential_update", "\"exact_linear\"", "\"exact_linear\" | \"radial_return\"", "time integration of the coupled tangential law"},

@@ -227,5 +227,30 @@ TEST(CliShroud, TheShroudClosesAtSpeedAndCampbellFollowsTheContact) {
   EXPECT_GT(top.at({18, 1}), 1.3 * top.at({0, 1}));
 }
 
+
+TEST(CliShroud, ForcedResponsePreloadsFromTheStaticContact) {
+  Scratch s("static_preload");
+  s.write("wheel.toml", kWheelCase);
+  ASSERT_EQ(s.run("static wheel.toml --set contact.interference=1e-5 --out static --quiet").status, 0);
+  const double load = run_json(s.dir() / "static")["static"]["normal_load_n"].get<double>();
+  const CliResult r = s.run(
+      "frf wheel.toml --set contact.interference=1e-5 --set 'contact.normal_preload=\"static\"' --set contact.pairs=3 "
+      "--set hbm.harmonics=1 --set hbm.time_samples=64 --set continuation.frequency_start_hz=60 "
+      "--set continuation.frequency_end_hz=70 --out frf --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto m = run_json(s.dir() / "frf")["frf_model"];
+  EXPECT_EQ(m["normal_preload_from"], "static");
+  EXPECT_EQ(m["static_open_pairs"].get<int>(), 0);
+  // Every pair closed: the patches' preloads add up to the static normal load.
+  EXPECT_NEAR(m["normal_preload_total_n"].get<double>(), load, 1e-9 * load);
+  EXPECT_NEAR(m["static_normal_load_n"].get<double>(), load, 1e-9 * load);
+
+  s.write("lumped.toml", "[structure]\ntype = \"lumped\"\nmass = [[1.0]]\nstiffness = [[1.0]]\n"
+                         "[contact]\nnormal_preload = \"static\"\n[[contact.elements]]\nx_dof = 0\n");
+  const CliResult bad = s.run("frf lumped.toml --quiet");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("contact.normal_preload"), std::string::npos) << bad.err;
+}
+
 }  // namespace
 }  // namespace shroudsim::testing
