@@ -7,6 +7,7 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string_view>
 
@@ -15,6 +16,7 @@
 #include "core/log.hpp"
 #include "io/output.hpp"
 #include "io/case.hpp"
+#include "io/results_folder.hpp"
 
 namespace shroudsim::app {
 namespace {
@@ -157,7 +159,18 @@ int run_cli(int argc, char** argv) {
     std::cerr << "shroudsim: error: " << o.case_file << ": " << e.what() << "\n";
     return 2;
   }
-  ctx.out_dir = o.out.empty() ? std::filesystem::path("results") / ctx.config.name : std::filesystem::path(o.out);
+  // The results folder: checked and locked before any work, written through a staging
+  // folder and replaced in one exchange at the end (io/results_folder.hpp).
+  std::unique_ptr<io::ResultsFolder> folder;
+  try {
+    folder = std::make_unique<io::ResultsFolder>(
+        o.out.empty() ? std::filesystem::path("results") / ctx.config.name : std::filesystem::path(o.out),
+        o.out.empty() ? "results folder (results/<name>)" : "--out");
+  } catch (const InputError& e) {
+    std::cerr << "shroudsim: error: " << e.what() << "\n";
+    return 2;
+  }
+  ctx.out_dir = folder->staging();
   ctx.threads = o.threads;
   ctx.overrides = o.sets;
   ctx.convergence = o.convergence;
@@ -178,15 +191,19 @@ int run_cli(int argc, char** argv) {
     std::cerr << "shroudsim: error: " << e.what() << "\n";
     status = 1, state = "failed", message = e.what();
   }
-  // Bad input leaves the result folder untouched; anything else reports what it did.
-  if (status != 2) {
+  // Bad input (and any other failure) leaves the results folder as it was; a run that
+  // finished (0) or whose numerics failed with what it computed (3) replaces it.
+  if (status == 0 || status == 3) {
     try {
       write_run_json(ctx, command, state, message);
+      folder->commit();
     } catch (const std::exception& e) {
-      std::cerr << "shroudsim: error: writing run.json: " << e.what() << "\n";
-      if (status == 0) status = 1;
+      std::cerr << "shroudsim: error: writing the results folder " << folder->target().string() << ": " << e.what()
+                << "\n";
+      status = 1;
     }
   }
+  ctx.out_dir = folder->target();
   if (status == 0) print_summary(ctx, command, clock.seconds());
   return status;
 }

@@ -1,5 +1,7 @@
 #include "mesh/sector_generator.hpp"
 
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -220,7 +222,9 @@ GenerateReport generate_sector_mesh(const SectorGeometry& g, const std::filesyst
   const Eigen::Vector3d n_high = std::cos(a) * e_t(theta_high) + std::sin(a) * Eigen::Vector3d::UnitZ();
 
   std::filesystem::create_directories(file.parent_path().empty() ? "." : file.parent_path());
-  const std::filesystem::path tmp = file.string() + ".tmp.msh";
+  // A name of its own per process: two runs of one case (a study, concurrent users) never
+  // write the same temporary file; the rename below makes the mesh appear whole.
+  const std::filesystem::path tmp = file.string() + ".tmp" + std::to_string(::getpid()) + ".msh";
   GenerateReport report;
   {
     detail::GmshSession session(verbose);

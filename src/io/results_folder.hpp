@@ -1,0 +1,44 @@
+#pragma once
+// A results folder holds one run (docs/contract.md "Result files"): a command writes into a
+// staging folder beside the target, `.<leaf>.staging-<pid>`, and commit() swaps it with the
+// target in one atomic exchange (renameat2 RENAME_EXCHANGE), so that the target is always
+// entirely the old run or entirely the new one, also when the run is killed. A lock file
+// beside it, `.<leaf>.lock` (flock), refuses a second run into the same folder while one is
+// writing. Only folders a run can own are replaced: a missing or empty folder, or one that
+// holds a run.json (a results folder); anything else is refused before any work.
+//
+// Usage:
+//   io::ResultsFolder out(user_out_path);     // checks, lock, staging; throws InputError
+//   ctx.out_dir = out.staging();              // every file of the run goes there
+//   ... run ...
+//   out.commit();                             // exit 0 or 3: the run replaces the folder
+//   (destructor without commit: staging removed, target untouched, lock released)
+#include <filesystem>
+#include <string>
+
+namespace shroudsim::io {
+
+class ResultsFolder {
+ public:
+  /// option: how the user named the folder in messages (e.g. "--out"). Throws InputError
+  /// when the target is a file or a folder that is not a results folder, its parent cannot
+  /// be created or written, the name is too long for the file system, or another run holds
+  /// the lock.
+  ResultsFolder(std::filesystem::path target, const std::string& option);
+  ~ResultsFolder();
+  ResultsFolder(const ResultsFolder&) = delete;
+  ResultsFolder& operator=(const ResultsFolder&) = delete;
+
+  const std::filesystem::path& target() const { return target_; }
+  const std::filesystem::path& staging() const { return staging_; }
+  /// The staging folder becomes the target (the old target is removed). Throws
+  /// std::runtime_error when the file system refuses.
+  void commit();
+
+ private:
+  std::filesystem::path target_, staging_;
+  int lock_fd_ = -1;
+  bool committed_ = false;
+};
+
+}  // namespace shroudsim::io

@@ -1,0 +1,130 @@
+// A results folder is one run (io/results_folder.hpp): killed runs leave the old folder,
+// concurrent runs into one folder are refused, bad input and bad --out touch nothing.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include "cli_runner.hpp"
+
+namespace shroudsim::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kQuickCase = R"(name = "coarse"
+[geometry]
+element_order = 1
+mesh_size = 0.025
+[modal]
+modes = 6
+harmonic_indices = [0, 1]
+[campbell]
+speed_points = 3
+engine_orders = [1]
+[hbm]
+harmonics = 1
+time_samples = 64
+[contact]
+pairs = 3
+[continuation]
+frequency_start_hz = 96.0
+frequency_end_hz = 110.0
+)";
+
+// Every file of a folder (relative name -> content).
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) files[fs::relative(e.path(), dir).string()] = slurp(e.path());
+  return files;
+}
+
+TEST(CliResults, AKilledRunLeavesTheOldFolderWhole) {
+  Scratch s("results_kill");
+  s.write("c.toml", kQuickCase);
+  ASSERT_EQ(s.run("run c.toml --out r --quiet").status, 0);
+  const auto old = snapshot(s.dir() / "r");
+  ASSERT_GT(old.size(), 8u);
+  // The second run differs (another frequency range): killed at several instants of the
+  // pipeline (mesh and modes cached: modes, campbell, forced response, plots), the folder is
+  // the old run, file for file; a run that got to the end is the new run, whole.
+  int old_seen = 0, new_seen = 0;
+  for (const char* at : {"0.3", "1.0", "2.0", "30"}) {
+    // Scratch::run prefixes the executable: a harmless --version, then the timed run.
+    const CliResult r = s.run(std::string("--version >/dev/null; timeout -s KILL ") + at + " '" SHROUDSIM_EXE
+                              "' run c.toml --set continuation.frequency_end_hz=109.0 --out r --quiet; true");
+    (void)r;
+    const auto now = snapshot(s.dir() / "r");
+    if (now == old) {
+      ++old_seen;
+    } else {
+      ++new_seen;
+      EXPECT_NE(now.at("run.json").find("\"status\": \"ok\""), std::string::npos) << at;
+      EXPECT_NE(now.at("run.json").find("109"), std::string::npos) << at;
+      EXPECT_EQ(now.count("frf.csv"), 1u) << at;
+      EXPECT_EQ(now.count("modes.csv"), 1u) << at;
+      EXPECT_NE(now.at("frf.csv"), old.at("frf.csv")) << at;
+      break;  // later kills would compare against the new run
+    }
+  }
+  EXPECT_GT(old_seen, 0);
+  EXPECT_EQ(new_seen, 1);  // the 30 s run finishes
+  // Killed runs' staging folders are removed by the next run into the folder.
+  ASSERT_EQ(s.run("run c.toml --out r --quiet").status, 0);
+  for (const auto& e : fs::directory_iterator(s.dir()))
+    EXPECT_EQ(e.path().filename().string().find(".staging-"), std::string::npos) << e.path();
+}
+
+TEST(CliResults, ASecondRunIntoTheSameFolderIsRefusedWhileTheFirstWrites) {
+  Scratch s("results_lock");
+  s.write("c.toml", kQuickCase);
+  ASSERT_EQ(s.run("mesh c.toml --out m --quiet").status, 0);
+  std::thread first([&] { EXPECT_EQ(s.run("run c.toml --out r --quiet").status, 0); });
+  // Wait until the first run holds the folder (its staging folder exists).
+  bool started = false;
+  for (int i = 0; i < 200 && !started; ++i) {
+    for (const auto& e : fs::directory_iterator(s.dir()))
+      if (e.path().filename().string().rfind(".r.staging-", 0) == 0) started = true;
+    if (!started) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(started);
+  const CliResult second = s.run("frf c.toml --out r --quiet");
+  first.join();
+  EXPECT_EQ(second.status, 2);
+  EXPECT_NE(second.err.find("another shroudsim run is writing this results folder"), std::string::npos) << second.err;
+  EXPECT_NE(second.err.find("--out"), std::string::npos) << second.err;
+  const std::string run_json = slurp(s.dir() / "r" / "run.json");
+  EXPECT_NE(run_json.find("\"command\": \"run\""), std::string::npos);
+}
+
+TEST(CliResults, BadOutAndBadInputTouchNothing) {
+  Scratch s("results_bad");
+  s.write("c.toml", kQuickCase);
+  s.write("a_file", "user data\n");
+  s.write("mine/notes.txt", "user data\n");
+  for (const char* out : {"a_file", "mine", "/proc/self/fakedir", "/dev/null"}) {
+    const CliResult r = s.run(std::string("modes c.toml --out ") + out);
+    EXPECT_EQ(r.status, 2) << out;
+    EXPECT_NE(r.err.find("--out"), std::string::npos) << out << ": " << r.err;
+    EXPECT_FALSE(fs::exists(s.dir() / "meshes")) << out << ": work started before --out was checked";
+  }
+  EXPECT_EQ(slurp(s.dir() / "a_file"), "user data\n");
+  EXPECT_EQ(slurp(s.dir() / "mine" / "notes.txt"), "user data\n");
+  // A case name too long for a folder name: refused before any work, naming the folder.
+  s.write("long.toml", "name = \"" + std::string(240, 'x') + "\"\n");
+  const CliResult lng = s.run("modes long.toml");
+  EXPECT_EQ(lng.status, 2);
+  EXPECT_NE(lng.err.find("characters"), std::string::npos) << lng.err;
+  // A bad key that is only checked after the modal stage (the excitation point on the hub)
+  // leaves the earlier run's folder as it was.
+  ASSERT_EQ(s.run("run c.toml --out r --quiet").status, 0);
+  const auto old = snapshot(s.dir() / "r");
+  const CliResult bad = s.run("run c.toml --set 'excitation.point=[0.0, 0.1, 0.0]' --out r --quiet");
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_EQ(snapshot(s.dir() / "r"), old);
+}
+
+}  // namespace
+}  // namespace shroudsim::testing
