@@ -194,14 +194,21 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   const std::string km_key = matrices_key(model.mesh, model.material);
   const fs::path km_file = cache_dir / ("km-" + km_key + ".bin");
   bool km_reused = false;
-  if (auto cached = modal::load_matrices(km_file);
-      cached && cached->K.rows() == model.mesh.n_dofs() && cached->M.rows() == model.mesh.n_dofs()) {
-    model.km = std::move(*cached);
+  std::string km_problem;
+  auto cached_km = modal::load_matrices(km_file, km_key, &km_problem);
+  if (cached_km && (cached_km->K.rows() != model.mesh.n_dofs() || cached_km->M.rows() != model.mesh.n_dofs())) {
+    km_problem = "its matrices do not match the mesh";
+    cached_km.reset();
+  }
+  if (!km_problem.empty())
+    ctx.report.warn("cache entry " + km_file.string() + " is corrupt (" + km_problem + "); recomputing");
+  if (cached_km) {
+    model.km = std::move(*cached_km);
     km_reused = true;
   } else {
     model.km = fe::assemble(model.mesh, model.material, ctx.threads);
     try {
-      modal::save_matrices(km_file, model.km);
+      modal::save_matrices(km_file, km_key, model.km);
     } catch (const std::exception& e) {
       ctx.report.warn(std::string("could not cache K and M: ") + e.what());
     }
@@ -265,9 +272,16 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   std::map<int, HarmonicOutcome> outcome;
   std::vector<int> to_solve;
   for (int h : canonical) {
-    const fs::path f = cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm, model.interface) + ".bin");
-    auto cached = modal::load_basis(f);
-    if (cached && cached->harmonic_index == h && cached->size() == model.options.modes) {
+    const std::string key = modes_key(km_key, h, model.options, speed_rpm, model.interface);
+    const fs::path f = cache_dir / ("modes-" + key + ".bin");
+    std::string problem;
+    auto cached = modal::load_basis(f, key, &problem);
+    if (cached && (cached->harmonic_index != h || cached->size() != model.options.modes)) {
+      problem = "its modes do not match the harmonic index or the mode count";
+      cached.reset();
+    }
+    if (!problem.empty()) ctx.report.warn("cache entry " + f.string() + " is corrupt (" + problem + "); recomputing");
+    if (cached) {
       HarmonicOutcome& o = outcome[h];
       o.reused = true;
       o.result.basis = std::move(*cached);
@@ -344,7 +358,8 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     if (!r.message.empty()) ctx.report.warn("harmonic index " + std::to_string(h) + ": " + r.message);
     if (!o.reused) {
       try {
-        modal::save_basis(cache_dir / ("modes-" + modes_key(km_key, h, model.options, speed_rpm, model.interface) + ".bin"), o.result.basis);
+        const std::string key = modes_key(km_key, h, model.options, speed_rpm, model.interface);
+        modal::save_basis(cache_dir / ("modes-" + key + ".bin"), key, o.result.basis);
       } catch (const std::exception& e) {
         ctx.report.warn(std::string("could not cache modes: ") + e.what());
       }

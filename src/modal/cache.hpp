@@ -1,22 +1,28 @@
 #pragma once
 // On-disk cache of FE matrices and modal bases (binary, this machine's byte order).
-// A file holds a magic tag, a format version and the payload; a file that does not match
-// (other version, truncated, other key) reads as "absent", never as wrong data. Writes go
-// to a temporary file renamed into place, so an interrupted run leaves no partial entry.
-// Keys (file names) are built by the caller from fe::Hasher fingerprints of everything the
-// entry depends on.
+// A file holds a magic tag (kind and format version), the key it was written under, the
+// payload and a 64-bit checksum (FNV-1a) of all of that. A file that does not match (other
+// kind or version, another key, truncated, any changed byte, non-finite modes) is never
+// used: load_* returns nullopt and names the problem, and the caller recomputes and
+// overwrites it. Writes go to a temporary file renamed into place, so an interrupted run
+// leaves no partial entry. Keys (also the file names) are built by the caller from
+// fe::Hasher fingerprints of everything the entry depends on.
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include "linalg/sparse.hpp"
 #include "modal/eigensolver.hpp"
 
 namespace shroudsim::modal {
 
-void save_matrices(const std::filesystem::path& path, const linalg::SparsePair<double>& km);
-std::optional<linalg::SparsePair<double>> load_matrices(const std::filesystem::path& path);
+/// problem (optional): set when the file exists but cannot be used (left empty when absent).
+void save_matrices(const std::filesystem::path& path, const std::string& key, const linalg::SparsePair<double>& km);
+std::optional<linalg::SparsePair<double>> load_matrices(const std::filesystem::path& path, const std::string& key,
+                                                        std::string* problem = nullptr);
 
-void save_basis(const std::filesystem::path& path, const ModalBasis& basis);
-std::optional<ModalBasis> load_basis(const std::filesystem::path& path);
+void save_basis(const std::filesystem::path& path, const std::string& key, const ModalBasis& basis);
+std::optional<ModalBasis> load_basis(const std::filesystem::path& path, const std::string& key,
+                                     std::string* problem = nullptr);
 
 }  // namespace shroudsim::modal

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <thread>
 
 #include "cli_runner.hpp"
@@ -124,6 +126,50 @@ TEST(CliResults, BadOutAndBadInputTouchNothing) {
   const CliResult bad = s.run("run c.toml --set 'excitation.point=[0.0, 0.1, 0.0]' --out r --quiet");
   EXPECT_EQ(bad.status, 2) << bad.err;
   EXPECT_EQ(snapshot(s.dir() / "r"), old);
+}
+
+
+// A cache entry with a changed byte (K and M, and the modes of a harmonic index; at the
+// start, the middle and the end of the file) is reported and recomputed: the results are
+// those of a clean run. Not byte for byte: a mode solved alone or beside another harmonic
+// index's solve (threads) differs at round-off, ~1e-15; a corrupted entry used would
+// differ at O(1) (or by the changed byte's weight).
+std::vector<double> frequencies(const std::string& modes_csv) {
+  std::vector<double> f;
+  std::istringstream in(modes_csv);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) f.push_back(std::stod(line.substr(line.rfind(',') + 1)));
+  return f;
+}
+
+TEST(CliResults, CorruptedCacheEntriesAreRecomputedNotUsed) {
+  constexpr double kRoundOff = 1e-12;
+  Scratch s("results_cache");
+  s.write("c.toml", kQuickCase);
+  ASSERT_EQ(s.run("modes c.toml --out clean --quiet").status, 0);
+  const std::string clean = slurp(s.dir() / "clean" / "modes.csv");
+  std::vector<fs::path> entries;
+  for (const auto& e : fs::directory_iterator(s.dir() / ".cache")) entries.push_back(e.path());
+  ASSERT_GE(entries.size(), 3u);  // K and M, modes of h = 0 and 1
+  int runs = 0;
+  for (const auto& file : entries)
+    for (double where : {0.1, 0.5, 0.999}) {
+      std::string bytes = slurp(file);
+      const std::size_t at = static_cast<std::size_t>(where * static_cast<double>(bytes.size() - 1));
+      bytes[at] = static_cast<char>(bytes[at] ^ 0x01);
+      std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+      const CliResult r = s.run("modes c.toml --out again");
+      ASSERT_EQ(r.status, 0) << r.err;
+      EXPECT_NE(r.err.find("is corrupt"), std::string::npos) << file << " byte " << at << ": " << r.err;
+      EXPECT_NE(r.err.find("recomputing"), std::string::npos);
+      const auto a = frequencies(clean), b = frequencies(slurp(s.dir() / "again" / "modes.csv"));
+      ASSERT_EQ(a.size(), b.size());
+      for (std::size_t i = 0; i < a.size(); ++i)
+        EXPECT_NEAR(b[i], a[i], kRoundOff * a[i]) << file << " byte " << at << " mode row " << i;
+      ++runs;
+    }
+  EXPECT_EQ(runs, 3 * static_cast<int>(entries.size()));
 }
 
 }  // namespace

@@ -2,6 +2,9 @@
 // 2n embedding returns each mode once, mass-normalised; failures are reported.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
 #include <Eigen/Eigenvalues>
 #include <filesystem>
 
@@ -234,23 +237,68 @@ TEST(ModalCache, RoundTripsMatricesAndBases) {
   std::filesystem::remove_all(dir);
   const mesh::Mesh m = fe::box_mesh(1, 1, 1, 2, 2, 2, 2);
   const auto km = fe::assemble(m, kSteel, 1);
-  save_matrices(dir / "km.bin", km);
-  const auto back = load_matrices(dir / "km.bin");
-  ASSERT_TRUE(back.has_value());
+  save_matrices(dir / "km.bin", "key-km", km);
+  std::string problem;
+  const auto back = load_matrices(dir / "km.bin", "key-km", &problem);
+  ASSERT_TRUE(back.has_value()) << problem;
   EXPECT_EQ((back->K - km.K).norm(), 0.0);
   EXPECT_EQ((back->M - km.M).norm(), 0.0);
   ModalBasis b{3, Eigen::VectorXd::LinSpaced(4, 1.0, 4.0), Eigen::MatrixXcd::Random(7, 4)};
-  save_basis(dir / "b.bin", b);
-  const auto bb = load_basis(dir / "b.bin");
+  save_basis(dir / "b.bin", "key-b", b);
+  const auto bb = load_basis(dir / "b.bin", "key-b");
   ASSERT_TRUE(bb.has_value());
   EXPECT_EQ(bb->harmonic_index, 3);
   EXPECT_EQ((bb->omega - b.omega).norm(), 0.0);
   EXPECT_EQ((bb->phi - b.phi).norm(), 0.0);
-  // A truncated or foreign file reads as absent.
-  std::filesystem::resize_file(dir / "b.bin", 40);
-  EXPECT_FALSE(load_basis(dir / "b.bin").has_value());
-  EXPECT_FALSE(load_matrices(dir / "b.bin").has_value());
-  EXPECT_FALSE(load_basis(dir / "missing.bin").has_value());
+  // Absent: nullopt and no problem. Another key, another kind: refused with a reason.
+  problem.clear();
+  EXPECT_FALSE(load_basis(dir / "missing.bin", "key-b", &problem).has_value());
+  EXPECT_TRUE(problem.empty());
+  EXPECT_FALSE(load_basis(dir / "b.bin", "key-other", &problem).has_value());
+  EXPECT_FALSE(problem.empty());
+  problem.clear();
+  EXPECT_FALSE(load_matrices(dir / "b.bin", "key-b", &problem).has_value());
+  EXPECT_FALSE(problem.empty());
+  std::filesystem::remove_all(dir);
+}
+
+// Any changed byte of an entry (at offsets spread over the header, the payload and the
+// checksum) or a truncation is detected: never used, always with a reason.
+TEST(ModalCache, CorruptedBytesAreDetectedAtEveryOffset) {
+  const auto dir = std::filesystem::temp_directory_path() / "shroudsim_modal_cache_corrupt";
+  std::filesystem::remove_all(dir);
+  const mesh::Mesh m = fe::box_mesh(1, 1, 1, 2, 2, 2, 1);
+  const auto km = fe::assemble(m, kSteel, 1);
+  ModalBasis b{1, Eigen::VectorXd::LinSpaced(5, 1.0, 5.0), Eigen::MatrixXcd::Random(9, 5)};
+  save_matrices(dir / "km.bin", "k", km);
+  save_basis(dir / "b.bin", "k", b);
+  int checked = 0;
+  for (const char* name : {"km.bin", "b.bin"}) {
+    const auto file = dir / name;
+    std::string bytes;
+    {
+      std::ifstream in(file, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::size_t n = bytes.size();
+    for (std::size_t k = 0; k < 64; ++k) {
+      const std::size_t at = k * (n - 1) / 63;
+      std::string bad = bytes;
+      bad[at] = static_cast<char>(bad[at] ^ 0x5a);
+      std::ofstream(file, std::ios::binary | std::ios::trunc) << bad;
+      std::string problem;
+      const bool used = std::string(name) == "km.bin" ? load_matrices(file, "k", &problem).has_value()
+                                                       : load_basis(file, "k", &problem).has_value();
+      EXPECT_FALSE(used) << name << " byte " << at;
+      EXPECT_FALSE(problem.empty()) << name << " byte " << at;
+      ++checked;
+    }
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes.substr(0, n / 2);
+    std::string problem;
+    EXPECT_FALSE(load_basis(file, "k", &problem).has_value());
+    EXPECT_FALSE(problem.empty());
+  }
+  EXPECT_EQ(checked, 128);
   std::filesystem::remove_all(dir);
 }
 
