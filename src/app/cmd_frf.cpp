@@ -235,6 +235,11 @@ forced::FrequencyResponseSettings frequency_response_settings(const io::Case& c)
 
 int cmd_frf(Context& ctx) {
   const io::Case& c = ctx.config;
+  if (c.excitation.force[0] == 0.0 && c.excitation.force[1] == 0.0 && c.excitation.force[2] == 0.0) {
+    const auto it = c.locations.find("excitation.force");
+    throw InputError((it != c.locations.end() ? it->second : c.file.string()) +
+                     ": excitation.force is zero: the forced response is the trivial zero solution (nothing to trace)");
+  }
   if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return frf_auto(ctx);
   log::Stopwatch clock;
   ForcedModel model = c.structure.type == "lumped" ? make_lumped_model(c) : make_sector_model(ctx);

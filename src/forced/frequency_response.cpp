@@ -151,8 +151,13 @@ double free_motion_peak(const frf::LinearPart& linear, const ReducedEquations& e
   const double lo = std::min(f_start, f_end), hi = std::max(f_start, f_end);
   for (double f : linear.resonances_hz())
     if (f > lo && f < hi) at.push_back(f);
+  // An undamped resonance in the range has an unbounded free response there: such samples
+  // do not set the unit (the friction bounds the forced response; the others do).
   double motion = 0.0;
-  for (double f : at) motion = std::max(motion, equations.linear_motion(f).lpNorm<Eigen::Infinity>());
+  for (double f : at) {
+    const double m = equations.linear_motion(f).lpNorm<Eigen::Infinity>();
+    if (std::isfinite(m)) motion = std::max(motion, m);
+  }
   return motion;
 }
 

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Dense>
 #include <toml++/toml.h>
 
@@ -385,6 +386,15 @@ void read_all(Reader& r, Case& c) {
     }
     Eigen::LLT<Eigen::MatrixXd> llt(st.mass);
     if (llt.info() != Eigen::Success) r.violates("structure.mass", r.node("structure.mass"), "positive definite");
+    // Stiffness and damping: positive semidefinite (a negative eigenvalue is an energy
+    // source, not a structure); tolerance: round-off of the largest eigenvalue.
+    for (const char* k : {"structure.stiffness", "structure.damping"}) {
+      const Eigen::MatrixXd& m = std::string(k) == "structure.stiffness" ? st.stiffness : st.damping;
+      if (m.size() == 0) continue;
+      const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(m, Eigen::EigenvaluesOnly).eigenvalues();
+      if (ev.minCoeff() < -1e-12 * std::max(ev.cwiseAbs().maxCoeff(), 1e-300))
+        r.violates(k, r.node(k), "positive semidefinite (its smallest eigenvalue is " + std::to_string(ev.minCoeff()) + ")");
+    }
   } else {
     for (const char* k : {"structure.mass", "structure.stiffness", "structure.damping"})
       if (r.node(k).as_array() && !r.node(k).as_array()->empty()) r.fail(k, &r.node(k), std::string(k) + " is only for structure.type = \"lumped\"");
@@ -409,6 +419,7 @@ void read_all(Reader& r, Case& c) {
   });
   g.element_order = r.integer("geometry.element_order", in_range_int(1, 2));
   g.mesh_size = r.number("geometry.mesh_size", positive);
+  g.max_elements = r.number("geometry.max_elements", positive);
   if (!lumped && st.mesh.empty())
     for (const auto& [key, what] : sector_geometry(c).validate()) r.violates(key, r.node(key), what);
 
@@ -633,6 +644,9 @@ Case parse_case(const std::string& text, const fs::path& file, const std::vector
   // --set overrides: validated like file keys, reported as "--set key=value".
   std::map<std::string, std::string> overridden;
   for (const auto& o : overrides) {
+    if (o.find_first_of("\n\r") != std::string::npos)
+      throw InputError(file.string() + ": --set " + o.substr(0, o.find_first_of("\n\r")) +
+                       "...: contains a line break; give one KEY=VALUE per --set");
     const auto [key, value] = split_override(o);
     if (!find_key(key) && key.rfind("expect.", 0) != 0)
       throw InputError(file.string() + ": --set " + o + ": unknown key '" + key + "'" + suggestion(key));
@@ -686,6 +700,12 @@ mesh::SectorGeometry sector_geometry(const Case& c) {
 Case load_case(const fs::path& file, const std::vector<std::string>& overrides) {
   if (!fs::exists(file)) throw InputError(file.string() + ": case file does not exist");
   if (fs::is_directory(file)) throw InputError(file.string() + ": is a folder, not a case file");
+  // Only regular files of a case file's size (a device or a pipe would be read forever).
+  constexpr std::uintmax_t kMaxCaseBytes = 16u << 20;
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) throw InputError(file.string() + ": not a regular file, not a case file");
+  if (fs::file_size(file, ec) > kMaxCaseBytes || ec)
+    throw InputError(file.string() + ": larger than 16 MiB (or unreadable): not a case file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot read the case file");
   std::ostringstream s;

@@ -35,6 +35,7 @@ struct GeometrySection {
   double shroud_contact_angle_deg = 45.0;
   int element_order = 2;
   double mesh_size = 0.01;
+  double max_elements = 1.0e6;          ///< refuse to mesh when the estimated element count is larger
 };
 
 struct MaterialSection {

@@ -48,6 +48,7 @@ const std::vector<KeySpec>& case_schema() {
       {"geometry.shroud_contact_angle_deg", "45.0", "0 <= angle < 90 (and faces must not cross)", "contact face angle to the radial plane (deg)"},
       {"geometry.element_order", "2", "1 | 2", "1 = 4-node, 2 = 10-node tetrahedra"},
       {"geometry.mesh_size", "0.01", "> 0, <= smallest feature", "target element size (m)"},
+      {"geometry.max_elements", "1.0e6", "> 0", "largest estimated element count meshed (volume / (0.04 mesh_size^3), which overestimates gmsh's count by up to 2x); a finer mesh_size is refused before meshing unless this is raised"},
 
       {"material.youngs_modulus", "210e9", "> 0", "Young's modulus (Pa)"},
       {"material.poisson_ratio", "0.3", "-1 < nu < 0.5", "Poisson's ratio"},

@@ -31,6 +31,13 @@ std::string point_text(const NodeMatrix& nodes, int i) {
 
 Mesh read_sector_mesh(const std::filesystem::path& file, const ReadOptions& options) {
   if (!std::filesystem::exists(file)) fail(file, "mesh file does not exist");
+  // Only regular files, of a size a sector mesh can have (a device or a pipe would be read
+  // forever).
+  constexpr std::uintmax_t kMaxMeshBytes = 16ull << 30;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) fail(file, "not a regular file");
+  if (std::filesystem::file_size(file, ec) > kMaxMeshBytes || ec)
+    fail(file, "larger than 16 GiB (or unreadable): not a sector mesh");
   SHROUDSIM_CHECK(options.sectors >= 1, "sectors >= 1");
   Mesh mesh;
   mesh.sectors = options.sectors;
@@ -103,7 +110,12 @@ Mesh read_sector_mesh(const std::filesystem::path& file, const ReadOptions& opti
     mesh.nodes.resize(static_cast<Eigen::Index>(used.size()), 3);
     for (std::size_t i = 0; i < used.size(); ++i) {
       const std::size_t row = tag_to_row.at(used[i]);
-      for (int c = 0; c < 3; ++c) mesh.nodes(static_cast<Eigen::Index>(i), c) = coords[3 * row + c];
+      for (int c = 0; c < 3; ++c) {
+        const double x = coords[3 * row + c];
+        if (!std::isfinite(x))
+          fail(file, "node " + std::to_string(used[i]) + " has a non-finite coordinate (" + std::to_string(x) + ")");
+        mesh.nodes(static_cast<Eigen::Index>(i), c) = x;
+      }
     }
     const Eigen::Index ne = static_cast<Eigen::Index>(conn.size() / npe);
     mesh.tets.resize(ne, npe);

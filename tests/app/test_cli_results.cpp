@@ -172,5 +172,78 @@ TEST(CliResults, CorruptedCacheEntriesAreRecomputedNotUsed) {
   EXPECT_EQ(runs, 3 * static_cast<int>(entries.size()));
 }
 
+
+const char* kLumped = R"(name = "lumped"
+[structure]
+type = "lumped"
+mass = [[1.0]]
+stiffness = [[3947.8417604357433]]
+damping = [[1.2566370614359172]]
+[excitation]
+force = 1.0
+[contact]
+model = "1d"
+normal_preload = 1.0
+friction_coefficient = 0.5
+tangential_stiffness = 3947.8417604357433
+[[contact.elements]]
+x_dof = 0
+[hbm]
+harmonics = 3
+time_samples = 64
+[continuation]
+frequency_start_hz = 5.0
+frequency_end_hz = 25.0
+)";
+
+// Hostile inputs found by trying: each is exit 2 with a message naming what is wrong, and
+// no work is done (no mesh generated, no results folder).
+TEST(CliResults, HostileInputsExitTwoBeforeAnyWork) {
+  Scratch s("results_hostile");
+  s.write("c.toml", kQuickCase);
+  s.write("l.toml", kLumped);
+  struct Hostile {
+    std::string args, expect;
+  };
+  const std::vector<Hostile> cases = {
+      {"frf l.toml --set 'hbm.harmonics=3\ncontinuation.max_points=1'", "line break"},  // a real newline
+      {"frf /dev/zero", "not a regular file"},
+      {"mesh c.toml --set geometry.mesh_size=1e-3", "geometry.max_elements"},
+      {"frf l.toml --set 'structure.damping=[[-0.1]]'", "positive semidefinite"},
+      {"frf l.toml --set 'structure.stiffness=[[-1.0]]'", "positive semidefinite"},
+      {"frf l.toml --set excitation.force=0.0", "excitation.force is zero"},
+  };
+  for (const auto& h : cases) {
+    const CliResult r = s.run(h.args + " --out r");
+    EXPECT_EQ(r.status, 2) << h.args << ": " << r.err;
+    EXPECT_NE(r.err.find(h.expect), std::string::npos) << h.args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(s.dir() / "r")) << h.args;
+    EXPECT_FALSE(fs::exists(s.dir() / "meshes")) << h.args;
+  }
+  // A mesh with a non-finite node coordinate: named, with the node and the file.
+  ASSERT_EQ(s.run("mesh c.toml --out m --quiet").status, 0);
+  std::string msh = slurp(s.dir() / "meshes" / "coarse.msh");
+  const std::size_t nodes = msh.find("$Nodes");
+  ASSERT_NE(nodes, std::string::npos);
+  // The first coordinate line of the section: the first line after it holding a '.'.
+  std::size_t line = msh.find('\n', nodes) + 1;
+  while (msh.substr(line, msh.find('\n', line) - line).find('.') == std::string::npos) line = msh.find('\n', line) + 1;
+  msh.replace(line, msh.find(' ', line) - line, "nan");
+  s.write("nan.msh", msh);
+  s.write("nan.toml", "name = \"nanmesh\"\n[structure]\nmesh = \"nan.msh\"\n");
+  const CliResult r = s.run("mesh nan.toml --out n");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("non-finite coordinate"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nan.msh"), std::string::npos) << r.err;
+  // The program's own mesh, truncated on disk: regenerated with a warning, not blamed on
+  // the user.
+  const std::string whole = slurp(s.dir() / "meshes" / "coarse.msh");
+  std::ofstream(s.dir() / "meshes" / "coarse.msh", std::ios::binary | std::ios::trunc) << whole.substr(0, whole.size() / 3);
+  const CliResult again = s.run("mesh c.toml --out m");
+  EXPECT_EQ(again.status, 0) << again.err;
+  EXPECT_NE(again.err.find("regenerating"), std::string::npos) << again.err;
+  EXPECT_EQ(slurp(s.dir() / "meshes" / "coarse.msh"), whole);
+}
+
 }  // namespace
 }  // namespace shroudsim::testing
