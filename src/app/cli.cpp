@@ -127,7 +127,7 @@ int run_cli(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    std::cerr << "shroudsim: error: " << e.what() << " (shroudsim --help lists the commands and options)\n";
     return 2;
   }
   if (print_defaults) {

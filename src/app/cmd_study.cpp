@@ -310,6 +310,14 @@ int cmd_study(Context& ctx) {
   const io::Case& base = ctx.config;
   if (base.study.vary.empty())
     throw InputError(base.locations.at("study.vary") + ": study.vary is empty: name at least one key and its values");
+  // Bounded work: the product's size before any point is built.
+  constexpr double kMaxStudyPoints = 10000;
+  double count = 1;
+  for (const auto& [key, values] : base.study.vary) count *= static_cast<double>(values.size());
+  if (count > kMaxStudyPoints)
+    throw InputError(base.locations.at("study.vary") + ": study.vary spans " + io::format_number(count) +
+                     " points (the product of its value lists), more than " + io::format_number(kMaxStudyPoints) +
+                     " a study runs; split it into several studies");
   // Cartesian product, first key slowest.
   std::vector<StudyPoint> points(1);
   for (const auto& [key, values] : base.study.vary) {
@@ -333,6 +341,14 @@ int cmd_study(Context& ctx) {
       throw InputError(base.locations.at("study.vary") + ": study point " + folder_name(p.values) + ": " + e.what());
     }
     p.folder = folder_name(p.values);
+  }
+  // Values that sanitize to one folder name ("a/b.msh" and "a_b.msh") get a suffix of
+  // their own (the point's index), so that no point overwrites another.
+  {
+    std::map<std::string, int> uses;
+    for (const auto& p : points) ++uses[p.folder];
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (uses[points[i].folder] > 1) points[i].folder += "__point" + std::to_string(i + 1);
   }
   const int workers = run_points(ctx, cases, points);
 
