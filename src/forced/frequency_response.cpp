@@ -41,6 +41,14 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   const double x_scale = ao.x_scale[0];
   how = "stuck contact";
   Eigen::VectorXd start = equations.stuck_solution(f);
+  {
+    // Equations that cannot be evaluated here have no solution to find: say why.
+    Eigen::VectorXd r;
+    if (!start.allFinite() || !equations.evaluate(start, f, r, nullptr, nullptr) || !r.allFinite())
+      throw NumericalError("the harmonic-balance equations are not finite at " + number(f) +
+                           " Hz: a harmonic of this frequency lies on a natural frequency without damping (the "
+                           "receptance is infinite there); give the structure damping or start the range elsewhere");
+  }
   if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
   how = "free response";
   start = equations.linear_motion(f);
