@@ -1,11 +1,16 @@
 #include "mesh/msh_reader.hpp"
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <set>
 #include <sstream>
 #include <unordered_map>
+#include <vector>
 
 #include "core/error.hpp"
 #include "mesh/checks.hpp"
@@ -18,6 +23,50 @@ constexpr int kGmshTet4 = 4, kGmshTet10 = 11, kGmshTri3 = 2, kGmshTri6 = 9;
 
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
   throw InputError(file.string() + ": " + what);
+}
+
+// gmsh 4.8 can crash (segmentation fault) or loop on a malformed mesh file, e.g. an element
+// that names a negative node tag. The file is read once in a child process first: a child
+// that dies by a signal or does not finish within kProbeSeconds is the file's fault, and
+// is reported as bad input instead of taking the whole run down.
+constexpr int kProbeSeconds = 600;
+
+void probe_in_child(const std::filesystem::path& file) {
+  const pid_t pid = ::fork();
+  if (pid < 0) return;  // cannot fork: read it directly
+  if (pid == 0) {
+    int code = 0;
+    try {
+      gmsh::initialize(0, nullptr, false);
+      gmsh::option::setNumber("General.Terminal", 0);
+      gmsh::open(file.string());
+      std::vector<int> types;
+      std::vector<std::vector<std::size_t>> tags, nodes;
+      gmsh::model::mesh::getElements(types, tags, nodes, -1, -1);
+      std::vector<std::size_t> node_tags;
+      std::vector<double> coords, params;
+      gmsh::model::mesh::getNodes(node_tags, coords, params, -1, -1, true, false);
+    } catch (...) {
+      code = 3;  // gmsh refused it: the reader below says so in its own words
+    }
+    ::_exit(code);
+  }
+  int status = 0;
+  for (int waited = 0; waited < 100 * kProbeSeconds; ++waited) {
+    const pid_t r = ::waitpid(pid, &status, WNOHANG);
+    if (r == pid) {
+      if (WIFSIGNALED(status))
+        fail(file, "gmsh crashed reading this file (signal " + std::to_string(WTERMSIG(status)) +
+                       "): it is not a well-formed mesh");
+      return;
+    }
+    if (r < 0) return;
+    ::usleep(10000);
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &status, 0);
+  fail(file, "gmsh did not finish reading this file within " + std::to_string(kProbeSeconds) +
+                 " s: it is not a well-formed mesh");
 }
 
 std::string point_text(const NodeMatrix& nodes, int i) {
@@ -44,6 +93,7 @@ Mesh read_sector_mesh(const std::filesystem::path& file, const ReadOptions& opti
 
   {
     detail::GmshSession session(false);
+    probe_in_child(file);  // under the session's lock: one gmsh user at a time
     try {
       gmsh::open(file.string());
     } catch (...) {
