@@ -170,6 +170,16 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
       ++branch.rejected_turns;
       it = -1;
     }
+    // A step over which the solution itself turned (the direction of x, e.g. the response's
+    // phase flipping across a resonance far narrower than the step, where the amplitude stays
+    // small in the problem's units and the tangent barely turns) has stepped over a peak.
+    if (it >= 0 && h > steps.kink()) {
+      const double a = y.head(n).norm(), b = y_new.head(n).norm();
+      if (a > 0 && b > 0 && y.head(n).dot(y_new.head(n)) < cos_max_turn * a * b) {
+        ++branch.rejected_turns;
+        it = -1;
+      }
+    }
     bool crossed_corner = false;
     if (it < 0 && h < steps.kink() && !corner_tried) {
       // No solution even at kink size: a corner of a nonsmooth branch.

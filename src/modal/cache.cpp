@@ -92,6 +92,12 @@ std::optional<std::istringstream> read_entry(const std::filesystem::path& path, 
     std::ifstream in(path, std::ios::binary);
     if (!in.read(bytes.data(), static_cast<std::streamsize>(size))) return fail("unreadable");
   }
+  // An entry of an earlier format (same kind, version 1: no key, no checksum) is simply
+  // absent to this version; a file of another kind is reported.
+  std::uint64_t head = 0;
+  std::memcpy(&head, bytes.data(), sizeof head);
+  if (head == (magic & ~(0xffull << 56)) + (static_cast<std::uint64_t>('1') << 56)) return std::nullopt;
+  if (head != magic) return fail("not a cache entry of this kind");
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + size - sizeof stored, sizeof stored);
   bytes.resize(size - sizeof stored);
