@@ -29,18 +29,6 @@ engine_orders = [1, 8, 9]
 rotating_effects = true
 )";
 
-std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
-  std::vector<std::vector<std::string>> rows;
-  std::istringstream s(text);
-  for (std::string line; std::getline(s, line);) {
-    std::vector<std::string> cells;
-    std::istringstream l(line);
-    for (std::string c; std::getline(l, c, ',');) cells.push_back(c);
-    rows.push_back(cells);
-  }
-  return rows;
-}
-
 // (speed, h, mode) -> frequency from campbell.csv.
 std::map<std::tuple<double, int, int>, double> campbell(const fs::path& file) {
   const auto rows = csv_rows(slurp(file));

@@ -32,16 +32,9 @@ rotating_effects = true
 // (h, mode) -> frequency [Hz] from modes.csv.
 std::map<std::pair<int, int>, double> modes_csv(const fs::path& file) {
   std::map<std::pair<int, int>, double> f;
-  std::istringstream s(slurp(file));
-  std::string line;
-  std::getline(s, line);
-  EXPECT_EQ(line, "harmonic_index,nodal_diameter,mode,frequency_hz");
-  while (std::getline(s, line)) {
-    std::vector<std::string> c;
-    std::istringstream l(line);
-    for (std::string x; std::getline(l, x, ',');) c.push_back(x);
-    f[{std::stoi(c[0]), std::stoi(c[2])}] = std::stod(c[3]);
-  }
+  const auto rows = csv_rows(slurp(file));
+  EXPECT_EQ(rows.front(), (std::vector<std::string>{"harmonic_index", "nodal_diameter", "mode", "frequency_hz"}));
+  for (std::size_t i = 1; i < rows.size(); ++i) f[{std::stoi(rows[i][0]), std::stoi(rows[i][2])}] = std::stod(rows[i][3]);
   return f;
 }
 
@@ -88,14 +81,10 @@ TEST(CliShroud, CampbellWithRotatingEffectsUsesTheStuckShroud) {
   ASSERT_EQ(r.status, 0) << r.err;
   // At 0 rpm the Campbell's frequencies are the stuck modes at rest.
   const auto rest = modes_csv(s.dir() / "modes" / "modes.csv");
-  std::istringstream c(slurp(s.dir() / "campbell" / "campbell.csv"));
-  std::string line;
-  std::getline(c, line);
+  const auto campbell = csv_rows(slurp(s.dir() / "campbell" / "campbell.csv"));
   int checked = 0;
-  while (std::getline(c, line)) {
-    std::vector<std::string> v;
-    std::istringstream l(line);
-    for (std::string x; std::getline(l, x, ',');) v.push_back(x);
+  for (std::size_t i = 1; i < campbell.size(); ++i) {
+    const auto& v = campbell[i];
     if (std::stod(v[0]) != 0.0) continue;
     EXPECT_NEAR(std::stod(v[4]), rest.at({std::stoi(v[1]), std::stoi(v[3])}), 1e-6 * std::stod(v[4]));
     ++checked;
@@ -141,18 +130,14 @@ struct StaticRow {
 };
 
 std::vector<StaticRow> static_rows(const fs::path& file) {
-  std::istringstream s(slurp(file));
-  std::string line;
-  std::getline(s, line);
-  EXPECT_EQ(line, "pair,high_node,low_node,x_m,y_m,z_m,area_m2,state,gap_m,normal_load_n,tangential_load_n,pressure_pa");
+  const std::string text = slurp(file);
+  EXPECT_EQ(text.find("nan"), std::string::npos);
+  const auto cells = csv_rows(text);
+  EXPECT_EQ(cells.front(), (std::vector<std::string>{"pair", "high_node", "low_node", "x_m", "y_m", "z_m", "area_m2", "state",
+                                                     "gap_m", "normal_load_n", "tangential_load_n", "pressure_pa"}));
   std::vector<StaticRow> rows;
-  while (std::getline(s, line)) {
-    std::vector<std::string> c;
-    std::istringstream l(line);
-    for (std::string x; std::getline(l, x, ',');) c.push_back(x);
-    rows.push_back({c[7], std::stod(c[8]), std::stod(c[9]), std::stod(c[10])});
-    EXPECT_EQ(line.find("nan"), std::string::npos) << line;
-  }
+  for (std::size_t i = 1; i < cells.size(); ++i)
+    rows.push_back({cells[i][7], std::stod(cells[i][8]), std::stod(cells[i][9]), std::stod(cells[i][10])});
   return rows;
 }
 
@@ -211,14 +196,10 @@ TEST(CliShroud, TheShroudClosesAtSpeedAndCampbellFollowsTheContact) {
   EXPECT_EQ(states[0]["closed"].get<int>(), 0);
   EXPECT_GT(states[2]["closed"].get<int>(), 0);
   const auto open = modes_csv(s.dir() / "open" / "modes.csv");
-  std::istringstream cs(slurp(s.dir() / "campbell" / "campbell.csv"));
-  std::string line;
-  std::getline(cs, line);
+  const auto campbell = csv_rows(slurp(s.dir() / "campbell" / "campbell.csv"));
   std::map<std::pair<int, int>, double> top;
-  while (std::getline(cs, line)) {
-    std::vector<std::string> v;
-    std::istringstream l(line);
-    for (std::string x; std::getline(l, x, ',');) v.push_back(x);
+  for (std::size_t i = 1; i < campbell.size(); ++i) {
+    const auto& v = campbell[i];
     const std::pair<int, int> key{std::stoi(v[1]), std::stoi(v[3])};
     if (std::stod(v[0]) == 0.0) EXPECT_NEAR(std::stod(v[4]), open.at(key), 1e-6 * open.at(key));
     if (std::stod(v[0]) == 3000.0) top[key] = std::stod(v[4]);
