@@ -1,5 +1,6 @@
 // `shroudsim run CASE`: every stage the case asks for, in order, reusing cached stages
-// (mesh, K and M, modes): sector cases mesh -> modes -> campbell -> frf; lumped cases frf.
+// (mesh, K and M, modes): sector cases mesh -> modes -> campbell -> static (when the case
+// gives a static speed or an interference) -> frf; lumped cases frf.
 #include "app/context.hpp"
 #include "core/log.hpp"
 
@@ -7,7 +8,10 @@ namespace shroudsim::app {
 
 int cmd_run(Context& ctx) {
   if (ctx.config.structure.type == "lumped") return cmd_frf(ctx);
-  for (auto* stage : {cmd_modes, cmd_campbell, cmd_frf}) {
+  const io::Case& c = ctx.config;
+  const bool static_contact = c.static_contact.speed_rpm > 0.0 || c.contact.interference != 0.0;
+  for (auto* stage : {cmd_modes, cmd_campbell, cmd_static, cmd_frf}) {
+    if (stage == cmd_static && !static_contact) continue;
     const int status = stage(ctx);
     if (status != 0) return status;
   }
