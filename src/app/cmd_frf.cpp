@@ -17,6 +17,7 @@
 #include "continuation/arclength.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "forced/discretization_search.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/lumped.hpp"
 #include "hbm/contact_evaluator.hpp"
@@ -36,38 +37,18 @@ contact::PairParameters pair_of(const io::ContactSection& c, const io::ContactEl
   return p;
 }
 
-/// hbm.harmonics and/or hbm.time_samples = "auto": the forced response is traced with H
-/// raised through 1, 3, 5, 7, 10, 15, 20, 25, 35, ... (up to hbm.auto_max_harmonics), then N
-/// doubled from the smallest power of two >= 4 (2H + 1), at least 64 (up to
-/// hbm.auto_max_time_samples), each until the peak amplitudes change by less than
-/// hbm.auto_tolerance (relative) from the previous trial (every resonance peak of the range
-/// at least 20 % of the largest, see peaks_change). While H is sought with N on
-/// "auto", N is the power of two >= 16 (2H + 1), at least 256. Every trial is a full curve in
-/// <out>/auto/H=..__N=../; the accepted trial's frf.csv and loops.csv are the result, and
-/// run.json lists every trial under "auto".
+/// hbm.harmonics and/or hbm.time_samples = "auto": the search of
+/// forced/discretization_search.hpp, each trial a full `frf` run into <out>/auto/H=..__N=../
+/// compared in memory; the accepted trial's frf.csv, loops.csv and peaks.csv are the result,
+/// and run.json lists every trial under "auto".
 int frf_auto(Context& ctx) {
   const io::Case& c = ctx.config;
   log::Stopwatch clock;
-  auto pow2_at_least = [](int v) {
-    int p = 1;
-    while (p < v) p *= 2;
-    return p;
-  };
-  struct Trial {
-    int h = 0, n = 0, status = 0;
-    double peak = 0.0, peak_f = 0.0, seconds = 0.0, change = -1.0;
-    std::string message;
-    nlohmann::json frf;
-    std::filesystem::path dir;
-  };
-  std::vector<Trial> trials;  // every trial, in order (std::deque-like use: only appended)
-  trials.reserve(64);
   const bool verbose = log::verbose();
-  // previous: the trial this one is compared with (null for the first of a search).
-  auto run_trial = [&](int h, int n, const Trial* previous) -> Trial {
-    Trial t;
-    t.h = h;
-    t.n = n;
+  std::vector<nlohmann::json> frf_sections;  // each trial's run.json "frf", in order
+  std::vector<std::filesystem::path> dirs;
+  auto run_trial = [&](int h, int n) {
+    forced::DiscretizationTrial t;
     Context tc;
     tc.config = c;
     tc.config.hbm.harmonics = h;
@@ -78,109 +59,80 @@ int frf_auto(Context& ctx) {
     tc.threads = ctx.threads;
     tc.overrides = ctx.overrides;
     tc.plots = false;
-    t.dir = tc.out_dir;
-    log::Stopwatch tclock;
     log::set_verbose(false);
+    int status = 3;
     try {
-      t.status = cmd_frf(tc);
+      status = cmd_frf(tc);
     } catch (const NumericalError& e) {
-      t.status = 3, t.message = e.what();
+      t.message = e.what();
     } catch (...) {
       log::set_verbose(verbose);
       throw;
     }
     log::set_verbose(verbose);
-    t.seconds = tclock.seconds();
-    t.frf = tc.report.json().value("frf", nlohmann::json::object());
-    t.peak = t.frf.value("peak_amplitude_m", 0.0);
-    t.peak_f = t.frf.value("peak_frequency_hz", 0.0);
-    if (previous && t.peak > 0 && t.status == 0 && previous->status == 0)
-      t.change = peaks_change(read_curve(previous->dir / "frf.csv"), read_curve(t.dir / "frf.csv"));
-    std::ostringstream s;
-    s << "frf: auto: H = " << h << ", N = " << n << ": "
-      << (t.status == 0 ? "peak " : "failed (" + t.message + "), peak so far ") << std::scientific << std::setprecision(4)
-      << t.peak << " m at " << std::defaultfloat << std::setprecision(6) << t.peak_f << " Hz";
-    if (t.change >= 0) s << ", change " << std::setprecision(2) << 100 * t.change << " %";
-    s << " (" << std::setprecision(3) << t.seconds << " s)";
-    log::info(s.str());
+    t.ok = status == 0;
+    const nlohmann::json frf = tc.report.json().value("frf", nlohmann::json::object());
+    t.peak_amplitude_m = frf.value("peak_amplitude_m", 0.0);
+    t.peak_frequency_hz = frf.value("peak_frequency_hz", 0.0);
+    t.curve = std::move(tc.frf_curve);
+    frf_sections.push_back(frf);
+    dirs.push_back(tc.out_dir);
     return t;
   };
-  const double tol = c.hbm.auto_tolerance;
-  bool converged_h = !c.hbm.harmonics_auto, converged_n = !c.hbm.time_samples_auto;
-  int h = c.hbm.harmonics, n = c.hbm.time_samples;
-  if (c.hbm.harmonics_auto) {
-    // No H = 2 step: a symmetric motion has no even harmonics, and 1 -> 2 would "converge".
-    std::vector<int> ladder = {1, 3, 5, 7, 10, 15, 20, 25};
-    for (int k = 35; k <= 200; k += 10) ladder.push_back(k);
-    for (int hk : ladder) {
-      if (hk > c.hbm.auto_max_harmonics) break;
-      const int nk = c.hbm.time_samples_auto ? std::max(256, pow2_at_least(16 * (2 * hk + 1))) : c.hbm.time_samples;
-      if (nk < 2 * hk + 1) break;  // a fixed N limits H
-      trials.push_back(run_trial(hk, nk, trials.empty() ? nullptr : &trials.back()));
-      const Trial& t = trials.back();
-      h = hk, n = nk;
-      if (t.change >= 0 && t.change < tol) {
-        converged_h = true;
-        break;
-      }
-    }
+  auto report_trial = [&](const forced::DiscretizationTrial& t) {
+    std::ostringstream s;
+    s << "frf: auto: H = " << t.harmonics << ", N = " << t.time_samples << ": "
+      << (t.ok ? "peak " : "failed (" + t.message + "), peak so far ") << std::scientific << std::setprecision(4)
+      << t.peak_amplitude_m << " m at " << std::defaultfloat << std::setprecision(6) << t.peak_frequency_hz << " Hz";
+    if (t.relative_change >= 0) s << ", change " << std::setprecision(2) << 100 * t.relative_change << " %";
+    s << " (" << std::setprecision(3) << t.seconds << " s)";
+    log::info(s.str());
+  };
+  forced::DiscretizationSettings settings;
+  settings.harmonics_auto = c.hbm.harmonics_auto;
+  settings.time_samples_auto = c.hbm.time_samples_auto;
+  settings.harmonics = c.hbm.harmonics;
+  settings.time_samples = c.hbm.time_samples;
+  settings.max_harmonics = c.hbm.auto_max_harmonics;
+  settings.max_time_samples = c.hbm.auto_max_time_samples;
+  settings.tolerance = c.hbm.auto_tolerance;
+  forced::DiscretizationSearch search;
+  try {
+    search = forced::search_discretization(settings, run_trial, report_trial);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.locations.at("hbm.harmonics") + ": hbm \"auto\": " + e.what());
   }
-  if (c.hbm.time_samples_auto) {
-    std::optional<std::size_t> last;  // index of the previous trial of this search
-    for (int nk = std::max(64, pow2_at_least(4 * (2 * h + 1))); nk <= c.hbm.auto_max_time_samples; nk *= 2) {
-      // The trial at (h, nk) may have been run while H was sought: reuse it.
-      std::optional<std::size_t> here;
-      for (std::size_t i = 0; i < trials.size(); ++i)
-        if (trials[i].h == h && trials[i].n == nk) here = i;
-      if (!here) {
-        trials.push_back(run_trial(h, nk, last ? &trials[*last] : nullptr));
-        here = trials.size() - 1;
-      } else if (last) {
-        Trial& t = trials[*here];
-        const Trial& p = trials[*last];
-        t.change = t.status == 0 && p.status == 0 && t.peak > 0
-                       ? peaks_change(read_curve(p.dir / "frf.csv"), read_curve(t.dir / "frf.csv"))
-                       : -1.0;
-      }
-      n = nk;
-      const double change = last ? trials[*here].change : -1.0;
-      last = here;
-      if (change >= 0 && change < tol) {
-        converged_n = true;
-        break;
-      }
-    }
-  }
-  // The accepted trial: the last one run at the chosen (h, n).
-  const Trial* chosen = nullptr;
-  for (const auto& t : trials)
-    if (t.h == h && t.n == n) chosen = &t;
-  if (!chosen) throw InputError(c.locations.at("hbm.harmonics") + ": hbm \"auto\": no H/N candidate fits the limits (auto_max_harmonics, auto_max_time_samples, time_samples >= 2H+1)");
+  const forced::DiscretizationTrial& chosen = search.trials[search.chosen];
+  const std::filesystem::path& chosen_dir = dirs[search.chosen];
   for (const char* f : {"frf.csv", "loops.csv", "peaks.csv"})
-    if (std::filesystem::exists(chosen->dir / f)) io::write_file_atomic(ctx.out_dir / f, read_file(chosen->dir / f));
-  ctx.report.section("frf") = chosen->frf;
+    if (std::filesystem::exists(chosen_dir / f)) io::write_file_atomic(ctx.out_dir / f, read_file(chosen_dir / f));
+  ctx.frf_curve = chosen.curve;
+  ctx.report.section("frf") = frf_sections[search.chosen];
+  const double tol = settings.tolerance;
+  const int h = search.harmonics, n = search.time_samples;
   auto& a = ctx.report.section("auto");
   a["tolerance"] = tol;
   a["harmonics"] = h;
   a["time_samples"] = n;
-  a["harmonics_converged"] = converged_h;
-  a["time_samples_converged"] = converged_n;
+  a["harmonics_converged"] = search.harmonics_converged;
+  a["time_samples_converged"] = search.time_samples_converged;
   a["trials"] = nlohmann::json::array();
-  for (const auto& t : trials)
-    a["trials"].push_back({{"harmonics", t.h}, {"time_samples", t.n}, {"status", t.status == 0 ? "ok" : "numerics_failed"},
-                          {"peak_amplitude_m", t.peak}, {"peak_frequency_hz", t.peak_f}, {"seconds", t.seconds},
-                          {"relative_change", t.change >= 0 ? nlohmann::json(t.change) : nlohmann::json(nullptr)}});
+  for (const auto& t : search.trials)
+    a["trials"].push_back({{"harmonics", t.harmonics}, {"time_samples", t.time_samples},
+                          {"status", t.ok ? "ok" : "numerics_failed"}, {"peak_amplitude_m", t.peak_amplitude_m},
+                          {"peak_frequency_hz", t.peak_frequency_hz}, {"seconds", t.seconds},
+                          {"relative_change", t.relative_change >= 0 ? nlohmann::json(t.relative_change) : nlohmann::json(nullptr)}});
   ctx.report.stage("frf", clock.seconds());
   log::info("frf: auto chose H = " + std::to_string(h) + ", N = " + std::to_string(n) + " (" +
-            std::to_string(trials.size()) + " trials)");
-  if (!converged_h)
+            std::to_string(search.trials.size()) + " trials)");
+  if (!search.harmonics_converged)
     ctx.report.warn("hbm.harmonics = \"auto\": the peak still changed by more than " + io::format_number(tol) +
                     " at H = " + std::to_string(h) + " (hbm.auto_max_harmonics or the fixed time_samples stopped the search)");
-  if (!converged_n)
+  if (!search.time_samples_converged)
     ctx.report.warn("hbm.time_samples = \"auto\": the peak still changed by more than " + io::format_number(tol) +
                     " at N = " + std::to_string(n) + " (hbm.auto_max_time_samples)");
   draw_plots(ctx);
-  if (chosen->status != 0) throw NumericalError("with H = " + std::to_string(h) + ", N = " + std::to_string(n) + ": " + chosen->message);
+  if (!chosen.ok) throw NumericalError("with H = " + std::to_string(h) + ", N = " + std::to_string(n) + ": " + chosen.message);
   return 0;
 }
 
@@ -296,6 +248,8 @@ int cmd_frf(Context& ctx) {
   for (const auto& pk : response.peaks)
     if (pk.amplitude_m >= peak) peak = pk.amplitude_m, peak_f = pk.frequency_hz, peak_index = pk.point;
   io::write_file_atomic(ctx.out_dir / "frf.csv", csv.str());
+  ctx.frf_curve.clear();
+  for (const auto& r : results) ctx.frf_curve.emplace_back(r.frequency_hz, r.amplitude);
 
   // Hysteresis loops of every pair (at most 10) at the peak.
   if (!response.points.empty()) {

@@ -1,10 +1,12 @@
 #pragma once
-// Forced-response curves as written to frf.csv, read back and compared: the measure of
-// convergence shared by hbm "auto" (cmd_frf.cpp) and `study --convergence` (cmd_study.cpp).
+// Forced-response curves as written to frf.csv, read back (`study --convergence` compares
+// its runs' curves with forced::peaks_change), and the mesh ladder's Richardson estimate.
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "forced/discretization_search.hpp"
 
 namespace shroudsim::app {
 
@@ -14,17 +16,9 @@ std::string read_file(const std::filesystem::path& p);
 /// (frequency [Hz], amplitude [m]) of every row of an frf.csv, in continuation order.
 std::vector<std::pair<double, double>> read_curve(const std::filesystem::path& file);
 
-/// The largest relative change between two forced-response curves at their resonance peaks:
-/// for every local maximum of either curve at least 20 % of its largest, the two curves'
-/// peaks within +-2 % of its frequency are compared (relative to the larger). One number for
-/// the whole range, so that a resonance smaller than the largest (and maybe the one that
-/// needs more harmonics) counts; a fold's local maximum beside a taller peak compares that
-/// peak. 1 when a peak has no counterpart at all.
-double peaks_change(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b);
-
-/// The largest shift [Hz] of a resonance peak between two curves, over the same peaks as
-/// peaks_change (the frequency of each curve's window peak).
-double peaks_shift_hz(const std::vector<std::pair<double, double>>& a, const std::vector<std::pair<double, double>>& b);
+/// Curve comparison (peaks_change, peaks_shift_hz) lives in forced/discretization_search.hpp.
+using forced::peaks_change;
+using forced::peaks_shift_hz;
 
 /// Richardson extrapolation of a mesh ladder (`study --convergence`).
 struct MeshConvergence {
