@@ -343,7 +343,10 @@ GenerateReport generate_sector_mesh(const SectorGeometry& g, const std::filesyst
     mesh = read_sector_mesh(tmp, ReadOptions{g.sectors, 1e-9});
   } catch (const InputError& e) {
     std::filesystem::remove(tmp);
-    throw NumericalError(std::string("the generated mesh failed its checks: ") + e.what());
+    // Named as the file it would have become (the temporary name means nothing to a user).
+    std::string what = e.what();
+    for (std::size_t at; (at = what.find(tmp.string())) != std::string::npos;) what.replace(at, tmp.string().size(), file.string());
+    throw NumericalError("the generated mesh " + file.string() + " failed its checks: " + what);
   }
   report.quality = element_quality(mesh);
   report.n_nodes = mesh.n_nodes();

@@ -30,15 +30,22 @@ def plot_frf(result_dir):
         runs[-1].append(i)
     fig, ax = plt.subplots(figsize=(8, 5))
     harmonics = [k for k in rows[0] if k.startswith("h") and k.endswith("_m")]
+    # h0 is the static part, h1 dominates: the higher ones, at most the 6 largest (H can be
+    # 200: a line and a legend entry each would bury the curve).
+    higher = harmonics[2:]
+    if len(higher) > 6:
+        higher = sorted(higher, key=lambda k: -max(float(r[k]) for r in rows))[:6]
+        higher.sort(key=lambda k: int(k[1:-2]))
     for n, run in enumerate(runs):
         fr = [f[i] for i in run]
         first = n == 0
         ax.semilogy(fr, [lin[i] for i in run], color="0.6", lw=1, label="linear, contact open" if first else None)
         ax.semilogy(fr, [a[i] for i in run], color="C0", lw=1.5,
                     label=("nonlinear (friction contact)" + (f", {len(runs)} pieces" if len(runs) > 1 else "")) if first else None)
-        for c, k in enumerate(harmonics[2:]):  # h0 is the static part, h1 dominates; show the higher ones
+        for c, k in enumerate(higher):
             ax.semilogy(fr, [max(float(rows[i][k]), 1e-30) for i in run], lw=0.7, ls="--", color=f"C{c + 1}",
-                        label=k[:-2] if first else None)
+                        label=(k[:-2] + (" (largest 6 of %d)" % (len(harmonics) - 2) if c == 0 and
+                                         len(harmonics) - 2 > 6 else "")) if first else None)
     # The peak as run.json reports it: the largest of the located peaks (peaks.csv), or the
     # largest point when none was located (or the file is absent).
     pf, pa = max(zip(f, a), key=lambda p: p[1])
