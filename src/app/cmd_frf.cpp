@@ -171,7 +171,10 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
     throw InputError(c.locations.at("hbm.harmonics") + ": hbm.harmonics = " + std::to_string(c.hbm.harmonics) +
                      " violates: harmonics = 1 for contact.model = \"1d_exact\" (the time-continuous single-harmonic law)");
   std::vector<std::string> errors;
-  if (!o.validate(&errors)) throw InputError(c.file.string() + ": " + errors.front());
+  if (!o.validate(&errors)) {
+    const auto it = c.locations.find("hbm.time_samples");
+    throw InputError((it != c.locations.end() ? it->second : c.file.string()) + ": hbm: " + errors.front());
+  }
   return o;
 }
 
@@ -197,7 +200,10 @@ int cmd_frf(Context& ctx) {
   ForcedModel model = c.structure.type == "lumped" ? make_lumped_model(c) : make_sector_model(ctx);
   for (const auto& p : model.pairs) {
     std::vector<std::string> errors;
-    if (!p.validate(*contact::parse_model(c.contact.model), &errors)) throw InputError(c.file.string() + ": " + errors.front());
+    if (!p.validate(*contact::parse_model(c.contact.model), &errors)) {
+      const auto it = c.locations.find("contact.model");
+      throw InputError((it != c.locations.end() ? it->second : c.file.string()) + ": [contact]: " + errors.front());
+    }
   }
   const hbm::ContactEvaluatorOptions eo = evaluator_options(c, ctx.threads);
   hbm::ContactEvaluator evaluator(eo, model.pairs);
