@@ -20,6 +20,10 @@ using forced::ForcedModel;
 ForcedModel make_lumped_model(const io::Case& c);
 /// structure.type = "sector": modal receptances of the sector, shroud contact pairs.
 ForcedModel make_sector_model(Context& ctx);
+/// The excitation and response points of a sector case: InputError (naming the key) when the
+/// nearest node is clamped or the point lies off the sector. `run` checks them on the mesh
+/// before any modal work.
+void check_forced_points(const io::Case& c, const mesh::Mesh& mesh);
 /// The contact evaluator options of a case (H, N, model, update, Jacobian kind).
 hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads);
 /// The [continuation] settings of a case's forced response (forced/frequency_response.hpp).

@@ -2,6 +2,7 @@
 // (mesh, K and M, modes): sector cases mesh -> modes -> campbell -> static (when the case
 // gives a static speed or an interference) -> frf; lumped cases frf.
 #include "app/context.hpp"
+#include "app/forced_stage.hpp"
 #include "core/log.hpp"
 
 namespace shroudsim::app {
@@ -9,6 +10,8 @@ namespace shroudsim::app {
 int cmd_run(Context& ctx) {
   if (ctx.config.structure.type == "lumped") return cmd_frf(ctx);
   const io::Case& c = ctx.config;
+  // Inputs that only the forced response reads, checked on the mesh before any modal work.
+  check_forced_points(c, obtain_mesh(ctx));
   const bool static_contact = c.static_contact.speed_rpm > 0.0 || c.contact.interference != 0.0;
   for (auto* stage : {cmd_modes, cmd_campbell, cmd_static, cmd_frf}) {
     if (stage == cmd_static && !static_contact) continue;

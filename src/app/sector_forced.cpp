@@ -37,6 +37,27 @@ int nearest_node(const mesh::Mesh& m, const std::array<double, 3>& p) {
 
 }  // namespace
 
+void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
+  // A point whose nearest node is clamped, or that lies off the sector, would give a silent
+  // zero (or meaningless) response: an input error naming the key.
+  const auto& hub = mesh.node_set("hub");
+  const double size = (mesh.nodes.colwise().maxCoeff() - mesh.nodes.colwise().minCoeff()).norm();
+  for (const auto& [key, point] : {std::pair{std::string("excitation.point"), c.excitation.point},
+                                   std::pair{std::string("response.point"), c.response.point}}) {
+    const int node = nearest_node(mesh, point);
+    const Eigen::RowVector3d x(point[0], point[1], point[2]);
+    const double distance = (mesh.nodes.row(node) - x).norm();
+    const auto it = c.locations.find(key);
+    const std::string where = it != c.locations.end() ? it->second : c.file.string();
+    if (std::find(hub.begin(), hub.end(), node) != hub.end())
+      throw InputError(where + ": " + key + ": the nearest node (" + std::to_string(node) +
+                       ") is on the clamped hub: it does not move; give a point on the blade or shroud");
+    if (distance > 0.1 * size)
+      throw InputError(where + ": " + key + " is " + io::format_number(distance) + " m from the nearest node of the sector (" +
+                       "model size " + io::format_number(size) + " m): give a point on the sector");
+  }
+}
+
 ForcedModel make_sector_model(Context& ctx) {
   const io::Case& c = ctx.config;
   const int nb = c.structure.sectors, m = c.excitation.engine_order;
@@ -102,25 +123,7 @@ ForcedModel make_sector_model(Context& ctx) {
   forcing.excitation_node = nearest_node(mesh, c.excitation.point);
   forcing.force = Eigen::Vector3d(c.excitation.force[0], c.excitation.force[1], c.excitation.force[2]);
   forcing.response_node = nearest_node(mesh, c.response.point);
-  // A point whose nearest node is clamped, or that lies off the sector, would give a silent
-  // zero (or meaningless) response: an input error naming the key.
-  {
-    const auto& hub = mesh.node_set("hub");
-    const double size = (mesh.nodes.colwise().maxCoeff() - mesh.nodes.colwise().minCoeff()).norm();
-    for (const auto& [key, point, node] : {std::tuple{std::string("excitation.point"), c.excitation.point, forcing.excitation_node},
-                                           std::tuple{std::string("response.point"), c.response.point, forcing.response_node}}) {
-      const Eigen::RowVector3d x(point[0], point[1], point[2]);
-      const double distance = (mesh.nodes.row(node) - x).norm();
-      const auto it = c.locations.find(key);
-      const std::string where = it != c.locations.end() ? it->second : c.file.string();
-      if (std::find(hub.begin(), hub.end(), node) != hub.end())
-        throw InputError(where + ": " + key + ": the nearest node (" + std::to_string(node) +
-                         ") is on the clamped hub: it does not move; give a point on the blade or shroud");
-      if (distance > 0.1 * size)
-        throw InputError(where + ": " + key + " is " + io::format_number(distance) + " m from the nearest node of the sector (" +
-                         "model size " + io::format_number(size) + " m): give a point on the sector");
-    }
-  }
+  check_forced_points(c, mesh);
   forcing.damping_ratio = c.modal.damping_ratio;
   forcing.residual_flexibility = c.modal.residual_flexibility;
   log::Stopwatch clock;
