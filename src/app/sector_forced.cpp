@@ -38,6 +38,14 @@ int nearest_node(const mesh::Mesh& m, const std::array<double, 3>& p) {
 }  // namespace
 
 void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
+  // More contact patches than the face has node pairs (one face pair per matched shroud
+  // pair, frf::shroud_face).
+  if (c.contact.pairs > static_cast<int>(mesh.shroud_pairs.size())) {
+    const auto it = c.locations.find("contact.pairs");
+    throw InputError((it != c.locations.end() ? it->second : c.file.string()) + ": contact.pairs = " +
+                     std::to_string(c.contact.pairs) + " violates: pairs <= " + std::to_string(mesh.shroud_pairs.size()) +
+                     " (the matched shroud node pairs of this mesh), or \"all\"");
+  }
   // A point whose nearest node is clamped, or that lies off the sector, would give a silent
   // zero (or meaningless) response: an input error naming the key.
   const auto& hub = mesh.node_set("hub");

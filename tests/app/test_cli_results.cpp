@@ -126,6 +126,14 @@ TEST(CliResults, BadOutAndBadInputTouchNothing) {
   const CliResult bad = s.run("run c.toml --set 'excitation.point=[0.0, 0.1, 0.0]' --out r --quiet");
   EXPECT_EQ(bad.status, 2) << bad.err;
   EXPECT_EQ(snapshot(s.dir() / "r"), old);
+  // ... and is checked before the modal stage (no modes line in the progress output), as is
+  // a contact.pairs above the face's node pairs.
+  for (const char* set : {"'excitation.point=[0.0, 0.1, 0.0]'", "contact.pairs=100000"}) {
+    const CliResult early = s.run(std::string("run c.toml --set ") + set + " --set modal.modes=5 --out r");
+    EXPECT_EQ(early.status, 2) << early.err;
+    EXPECT_EQ(early.err.find("modes h ="), std::string::npos) << set << ": " << early.err;
+    EXPECT_EQ(snapshot(s.dir() / "r"), old);
+  }
 }
 
 
