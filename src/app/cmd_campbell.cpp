@@ -66,23 +66,19 @@ struct Sweep {
 
 int cmd_campbell(Context& ctx) {
   const io::Case& c = ctx.config;
-  auto where = [&](const std::string& key) {
-    auto it = c.locations.find(key);
-    return it != c.locations.end() ? it->second : c.file.string();
-  };
   if (c.structure.type != "sector")
-    throw InputError(where("structure.type") + ": structure.type = \"" + c.structure.type +
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type +
                      "\": `campbell` needs an FE sector (structure.type = \"sector\")");
   if (c.campbell.speed_rpm.size() != 2 || !(c.campbell.speed_rpm[0] >= 0.0) ||
       !(c.campbell.speed_rpm[1] > c.campbell.speed_rpm[0]))
-    throw InputError(where("campbell.speed_rpm") + ": campbell.speed_rpm violates: [min, max] with 0 <= min < max");
+    throw InputError(c.where("campbell.speed_rpm") + ": campbell.speed_rpm violates: [min, max] with 0 <= min < max");
   if (c.campbell.speed_points < 2)
-    throw InputError(where("campbell.speed_points") + ": campbell.speed_points = " +
+    throw InputError(c.where("campbell.speed_points") + ": campbell.speed_points = " +
                      std::to_string(c.campbell.speed_points) + " violates: speed_points >= 2");
   const int nb = c.structure.sectors;
   for (int e : c.campbell.engine_orders)
     if (e < 1)
-      throw InputError(where("campbell.engine_orders") + ": campbell.engine_orders contains " + std::to_string(e) +
+      throw InputError(c.where("campbell.engine_orders") + ": campbell.engine_orders contains " + std::to_string(e) +
                        ", which violates: engine orders >= 1");
 
   // The [modal] harmonic indices plus those the engine orders excite.
@@ -149,8 +145,8 @@ int cmd_campbell(Context& ctx) {
     int static_points = np;
     if (follow_contact) {
       log::Stopwatch static_clock;
-      all_springs = shroud_springs(c, model.mesh);
       frf::StaticShroudSolver solver(model.mesh, model.km, &ops, static_shroud_settings(c, 0.0));
+      all_springs = solver.state().springs;  // the static contact's elements, in its order
       nlohmann::json states = nlohmann::json::array();
       try {
         const int pre = rpm[0] > 0.0 ? std::max(1, c.static_contact.increments) : 0;

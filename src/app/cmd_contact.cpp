@@ -27,14 +27,8 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kTimingSeconds = 0.05;
 constexpr int kMaxRepeats = 1000;
 
-/// "file:line:col" of a key when known, else the case file.
-std::string where(const io::Case& c, const std::string& key) {
-  const auto it = c.locations.find(key);
-  return it != c.locations.end() ? it->second : c.file.string();
-}
-
 [[noreturn]] void refuse(const io::Case& c, const std::string& key, const std::string& what) {
-  throw InputError(where(c, key) + ": " + key + " " + what);
+  throw InputError(c.where(key) + ": " + key + " " + what);
 }
 
 template <class F>
@@ -108,7 +102,7 @@ int cmd_contact(Context& ctx) {
     std::vector<std::string> errors;
     if (!pair.validate(*model, &errors)) {
       const std::string key = "contact." + errors.front().substr(0, errors.front().find(' '));
-      throw InputError(where(c, key) + ": contact." + errors.front());
+      throw InputError(c.where(key) + ": contact." + errors.front());
     }
   }
 

@@ -172,8 +172,7 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
                      " violates: harmonics = 1 for contact.model = \"1d_exact\" (the time-continuous single-harmonic law)");
   std::vector<std::string> errors;
   if (!o.validate(&errors)) {
-    const auto it = c.locations.find("hbm.time_samples");
-    throw InputError((it != c.locations.end() ? it->second : c.file.string()) + ": hbm: " + errors.front());
+    throw InputError(c.where("hbm.time_samples") + ": hbm: " + errors.front());
   }
   return o;
 }
@@ -191,9 +190,7 @@ forced::FrequencyResponseSettings frequency_response_settings(const io::Case& c)
 int cmd_frf(Context& ctx) {
   const io::Case& c = ctx.config;
   if (c.excitation.force[0] == 0.0 && c.excitation.force[1] == 0.0 && c.excitation.force[2] == 0.0) {
-    const auto it = c.locations.find("excitation.force");
-    throw InputError((it != c.locations.end() ? it->second : c.file.string()) +
-                     ": excitation.force is zero: the forced response is the trivial zero solution (nothing to trace)");
+    throw InputError(c.where("excitation.force") + ": excitation.force is zero: the forced response is the trivial zero solution (nothing to trace)");
   }
   if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return frf_auto(ctx);
   log::Stopwatch clock;
@@ -201,8 +198,7 @@ int cmd_frf(Context& ctx) {
   for (const auto& p : model.pairs) {
     std::vector<std::string> errors;
     if (!p.validate(*contact::parse_model(c.contact.model), &errors)) {
-      const auto it = c.locations.find("contact.model");
-      throw InputError((it != c.locations.end() ? it->second : c.file.string()) + ": [contact]: " + errors.front());
+      throw InputError(c.where("contact.model") + ": [contact]: " + errors.front());
     }
   }
   const hbm::ContactEvaluatorOptions eo = evaluator_options(c, ctx.threads);

@@ -37,10 +37,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string location(const io::Case& c, const std::string& key) {
-  auto it = c.locations.find(key);
-  return it != c.locations.end() ? it->second : c.file.string();
-}
 
 std::string fixed(double v, int digits) {
   std::ostringstream s;
@@ -117,25 +113,12 @@ Shroud case_shroud(const io::Case& c) {
 }
 
 std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mesh::Mesh& mesh) {
-  const std::vector<frf::ShroudFaceNode> face = frf::shroud_face(mesh);
-  double area = 0.0;
-  for (const auto& f : face) area += f.area;
-  if (face.empty() || !(area > 0))
-    throw InputError(location(c, "modal.shroud") + ": modal.shroud = \"" + c.modal.shroud + "\" needs matched shroud_high/shroud_low node pairs, and the mesh has none");
-  std::vector<cyclic::InterfaceSpring> springs;
-  springs.reserve(face.size());
-  const double angle = c.contact.frame_angle_deg * std::numbers::pi / 180.0;
-  for (const auto& f : face) {
-    cyclic::InterfaceSpring sp;
-    sp.high_node = f.high;
-    sp.low_node = f.low;
-    sp.frame = frf::contact_frame(f.normal, mesh.nodes.row(f.high).transpose(), angle);
-    const double share = f.area / area;
-    sp.stiffness = Eigen::Vector3d(c.contact.tangential_stiffness, c.contact.tangential_stiffness,
-                                   c.contact.normal_stiffness) * share;
-    springs.push_back(sp);
+  try {
+    return frf::face_springs(mesh, frf::shroud_face(mesh), c.contact.normal_stiffness, c.contact.tangential_stiffness,
+                             c.contact.frame_angle_deg * std::numbers::pi / 180.0);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.where("modal.shroud") + ": modal.shroud = \"" + c.modal.shroud + "\": " + e.what());
   }
-  return springs;
 }
 
 modal::StiffnessFactor ModalModel::stiffness_factor(int h) {
@@ -156,7 +139,7 @@ std::vector<int> modal_harmonic_indices(const io::Case& c) {
   }
   for (int h : c.modal.harmonic_indices) {
     if (h < 0 || h >= nb)
-      throw InputError(location(c, "modal.harmonic_indices") + ": modal.harmonic_indices contains " +
+      throw InputError(c.where("modal.harmonic_indices") + ": modal.harmonic_indices contains " +
                        std::to_string(h) + ", which violates: 0 <= h < structure.sectors = " + std::to_string(nb));
     hs.push_back(h);
   }
@@ -174,12 +157,12 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   model.mesh.sectors = nb;
   model.material = {c.material.youngs_modulus, c.material.poisson_ratio, c.material.density};
   if (!model.material.valid())
-    throw InputError(location(c, "material.youngs_modulus") +
+    throw InputError(c.where("material.youngs_modulus") +
                      ": [material] violates: youngs_modulus > 0, -1 < poisson_ratio < 0.5, density > 0");
   model.options.modes = c.modal.modes;
   model.options.method = c.modal.eigensolver == "spectra" ? modal::EigenMethod::Spectra : modal::EigenMethod::Block;
   std::vector<std::string> errors;
-  if (!model.options.validate(&errors)) throw InputError(location(c, "modal.modes") + ": modal." + errors.front());
+  if (!model.options.validate(&errors)) throw InputError(c.where("modal.modes") + ": modal." + errors.front());
 
   const fs::path cache_dir = c.directory / ".cache";
   auto& report = ctx.report.section("modal");
@@ -187,7 +170,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   report["sectors"] = nb;
   report["modes_per_harmonic_index"] = model.options.modes;
   report["shroud"] = shroud == Shroud::stuck ? "stuck" : shroud == Shroud::contact ? "contact" : "open";
-  if (shroud != Shroud::open) model.interface = shroud_springs(c, model.mesh);
+  if (shroud == Shroud::stuck) model.interface = shroud_springs(c, model.mesh);
 
   // K and M.
   log::Stopwatch clock;
@@ -222,10 +205,15 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
 
   if (shroud == Shroud::contact) {
     // The pairs the interference closes at rest (campbell follows the state with speed).
-    const frf::StaticShroud st = frf::solve_static_shroud(model.mesh, model.km, nullptr, static_shroud_settings(c, 0.0));
+    frf::StaticShroud st;
+    try {
+      st = frf::solve_static_shroud(model.mesh, model.km, nullptr, static_shroud_settings(c, 0.0));
+    } catch (const InputError& e) {
+      throw InputError(c.where("modal.shroud") + ": modal.shroud = \"contact\": " + e.what());
+    }
     std::vector<cyclic::InterfaceSpring> closed;
     for (std::size_t i = 0; i < st.results.size(); ++i)
-      if (st.results[i].state != contact::StaticState::open) closed.push_back(model.interface[i]);
+      if (st.results[i].state != contact::StaticState::open) closed.push_back(st.springs[i]);
     report["shroud_contact_at_rest"] = {{"closed", closed.size()}, {"open", st.results.size() - closed.size()},
                                         {"normal_load_n", st.normal_load()}};
     model.interface = std::move(closed);
@@ -532,7 +520,7 @@ void draw_plots(Context& ctx) {
 int cmd_modes(Context& ctx) {
   const io::Case& c = ctx.config;
   if (c.structure.type != "sector")
-    throw InputError(location(c, "structure.type") + ": structure.type = \"" + c.structure.type +
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type +
                      "\": `modes` needs an FE sector (structure.type = \"sector\")");
   ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), /*keep_factors=*/false, 0.0, case_shroud(c));
   write_modes_csv(ctx, model);

@@ -33,9 +33,8 @@ frf::StaticShroudSettings static_shroud_settings(const io::Case& c, double speed
 int cmd_static(Context& ctx) {
   const io::Case& c = ctx.config;
   if (c.structure.type != "sector")
-    throw InputError(c.locations.count("structure.type") ? c.locations.at("structure.type") + ": structure.type = \"" +
-                                                               c.structure.type + "\": `static` needs an FE sector"
-                                                         : c.file.string() + ": `static` needs an FE sector");
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type +
+                     "\": `static` needs an FE sector");
   ModalModel model = run_modal_stage(ctx, {}, /*keep_factors=*/false);
   log::Stopwatch clock;
   const double speed = c.static_contact.speed_rpm;

@@ -41,8 +41,7 @@ void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
   // More contact patches than the face has node pairs (one face pair per matched shroud
   // pair, frf::shroud_face).
   if (c.contact.pairs > static_cast<int>(mesh.shroud_pairs.size())) {
-    const auto it = c.locations.find("contact.pairs");
-    throw InputError((it != c.locations.end() ? it->second : c.file.string()) + ": contact.pairs = " +
+    throw InputError(c.where("contact.pairs") + ": contact.pairs = " +
                      std::to_string(c.contact.pairs) + " violates: pairs <= " + std::to_string(mesh.shroud_pairs.size()) +
                      " (the matched shroud node pairs of this mesh), or \"all\"");
   }
@@ -55,8 +54,7 @@ void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
     const int node = nearest_node(mesh, point);
     const Eigen::RowVector3d x(point[0], point[1], point[2]);
     const double distance = (mesh.nodes.row(node) - x).norm();
-    const auto it = c.locations.find(key);
-    const std::string where = it != c.locations.end() ? it->second : c.file.string();
+    const std::string where = c.where(key);
     if (std::find(hub.begin(), hub.end(), node) != hub.end())
       throw InputError(where + ": " + key + ": the nearest node (" + std::to_string(node) +
                        ") is on the clamped hub: it does not move; give a point on the blade or shroud");

@@ -128,22 +128,22 @@ void CyclicSector::set_interface(std::vector<InterfaceSpring> springs) {
   springs_ = std::move(springs);
 }
 
-SparseMatrixC CyclicSector::interface_rows(int h, const std::vector<InterfaceSpring>& springs) const {
+void CyclicSector::add_relative_rows(std::vector<Eigen::Triplet<Complex>>& t, int row, const Eigen::Matrix3d& frame,
+                                     int high_node, int low_node, double weight, int h) const {
   const Complex e = phase(h);
-  const Eigen::Matrix3d R = rotation_z(2.0 * std::numbers::pi / sectors_);
+  const Eigen::Matrix3d LR = frame * rotation_z(2.0 * std::numbers::pi / sectors_);
+  for (int a = 0; a < 3; ++a)
+    for (int j = 0; j < 3; ++j) {
+      t.emplace_back(row + a, 3 * high_node + j, weight * frame(a, j));  // 1.0 * x == x: a node pair exactly
+      t.emplace_back(row + a, 3 * low_node + j, -e * (weight * LR(a, j)));
+    }
+}
+
+SparseMatrixC CyclicSector::interface_rows(int h, const std::vector<InterfaceSpring>& springs) const {
   std::vector<Eigen::Triplet<Complex>> t;
   t.reserve(springs.size() * 18);
-  for (std::size_t i = 0; i < springs.size(); ++i) {
-    const InterfaceSpring& s = springs[i];
-    const Eigen::Matrix3d LR = s.frame * R;
-    for (int a = 0; a < 3; ++a) {
-      const int row = static_cast<int>(3 * i) + a;
-      for (int j = 0; j < 3; ++j) {
-        if (s.frame(a, j) != 0.0) t.emplace_back(row, 3 * s.high_node + j, s.frame(a, j));
-        if (LR(a, j) != 0.0) t.emplace_back(row, 3 * s.low_node + j, -e * LR(a, j));
-      }
-    }
-  }
+  for (std::size_t i = 0; i < springs.size(); ++i)
+    add_relative_rows(t, static_cast<int>(3 * i), springs[i].frame, springs[i].high_node, springs[i].low_node, 1.0, h);
   SparseMatrixC S(static_cast<Eigen::Index>(3 * springs.size()), n_full_);
   S.setFromTriplets(t.begin(), t.end());  // a spring from a node to itself sums its entries
   return S;

@@ -79,6 +79,12 @@ class CyclicSector {
   /// S_h: the relative displacements of the springs (3 rows per spring, row 3i + a is
   /// L_i(a, :) (u_q - exp(i h alpha) R u_p)) from all n_full sector DOFs.
   linalg::SparseMatrixC interface_rows(int h) const { return interface_rows(h, springs_); }
+  /// Adds weight * L (u_q - exp(i h alpha) R u_p), the relative displacement of node q of a
+  /// sector and node p of the next in the frame L (rows; docs/physics.md section 3), to rows
+  /// row .. row + 2 of t (columns: all n_full sector DOFs). The one definition of that
+  /// operator: the springs here and the forced response's contact rows both use it.
+  void add_relative_rows(std::vector<Eigen::Triplet<linalg::Complex>>& t, int row, const Eigen::Matrix3d& frame,
+                         int high_node, int low_node, double weight, int h) const;
   /// The same for any springs (their stiffness is not used).
   linalg::SparseMatrixC interface_rows(int h, const std::vector<InterfaceSpring>& springs) const;
 

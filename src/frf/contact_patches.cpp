@@ -128,6 +128,25 @@ Eigen::Matrix3d contact_frame(const Eigen::Vector3d& n, const Eigen::Vector3d& x
   return l;
 }
 
+std::vector<cyclic::InterfaceSpring> face_springs(const mesh::Mesh& m, const std::vector<ShroudFaceNode>& face,
+                                                  double normal_stiffness, double tangential_stiffness,
+                                                  double frame_angle) {
+  double area = 0.0;
+  for (const auto& f : face) area += f.area;
+  if (face.empty() || !(area > 0)) throw std::invalid_argument("the mesh has no matched shroud_high/shroud_low node pairs");
+  std::vector<cyclic::InterfaceSpring> springs;
+  springs.reserve(face.size());
+  for (const auto& f : face) {
+    cyclic::InterfaceSpring sp;
+    sp.high_node = f.high;
+    sp.low_node = f.low;
+    sp.frame = contact_frame(f.normal, m.nodes.row(f.high).transpose(), frame_angle);
+    sp.stiffness = Eigen::Vector3d(tangential_stiffness, tangential_stiffness, normal_stiffness) * (f.area / area);
+    springs.push_back(sp);
+  }
+  return springs;
+}
+
 std::vector<SectorContactPair> contact_pairs(const mesh::Mesh& m, const std::vector<ShroudFaceNode>& face,
                                              const std::vector<ContactPatch>& patches,
                                              ContactDiscretization discretization, double frame_angle) {

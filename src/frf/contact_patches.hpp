@@ -58,6 +58,14 @@ bool parse_discretization(const std::string& s, ContactDiscretization& out);
 /// axial), t2 = n x t1, both turned about n by `angle` [rad].
 Eigen::Matrix3d contact_frame(const Eigen::Vector3d& normal, const Eigen::Vector3d& x, double angle);
 
+/// One spring per face pair across the sector boundary (the stuck shroud, docs/physics.md
+/// sections 1 and 8): stiffness (kt, kt, kn) a_i / A of the face's totals (A the face area),
+/// in the pair's contact frame turned by frame_angle [rad]. Same order as the face. Throws
+/// std::invalid_argument when the face is empty or has no area.
+std::vector<cyclic::InterfaceSpring> face_springs(const mesh::Mesh& mesh, const std::vector<ShroudFaceNode>& face,
+                                                  double normal_stiffness, double tangential_stiffness,
+                                                  double frame_angle);
+
 /// One SectorContactPair per patch, in the given discretization; frames turned by
 /// frame_angle [rad]. A single-member patch is exactly the node pair of the node form.
 std::vector<SectorContactPair> contact_pairs(const mesh::Mesh& mesh, const std::vector<ShroudFaceNode>& face,

@@ -15,24 +15,13 @@ using Complex = std::complex<double>;
 
 void add_contact_rows(std::vector<Eigen::Triplet<Complex>>& t, const std::vector<SectorContactPair>& pairs,
                       const cyclic::CyclicSector& sector, int h) {
-  const double alpha = 2.0 * std::numbers::pi / sector.sectors();
-  const Eigen::Matrix3d rot = cyclic::rotation_z(alpha);
-  const Complex phase = std::exp(Complex(0.0, h * alpha));
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const Eigen::Matrix3d& l = pairs[i].frame;
-    const Eigen::Matrix3d lr = l * rot;
-    auto node_pair = [&](int high, int low, double weight) {
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) {
-          const int row = 3 * static_cast<int>(i) + a;
-          t.emplace_back(row, 3 * high + b, weight * l(a, b));
-          t.emplace_back(row, 3 * low + b, -phase * (weight * lr(a, b)));
-        }
-    };
+    const int row = 3 * static_cast<int>(i);
     if (pairs[i].patch.empty()) {
-      node_pair(pairs[i].high_node, pairs[i].low_node, 1.0);  // 1.0 * x == x: the node form exactly
+      sector.add_relative_rows(t, row, pairs[i].frame, pairs[i].high_node, pairs[i].low_node, 1.0, h);
     } else {
-      for (const PatchNode& m : pairs[i].patch) node_pair(m.high_node, m.low_node, m.weight);
+      for (const PatchNode& m : pairs[i].patch)
+        sector.add_relative_rows(t, row, pairs[i].frame, m.high_node, m.low_node, m.weight, h);
     }
   }
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -29,15 +30,16 @@ namespace {
 StaticShroud face_elements(const mesh::Mesh& mesh, const StaticShroudSettings& settings) {
   StaticShroud out;
   out.face = shroud_face(mesh);
-  double area = 0.0;
-  for (const auto& f : out.face) area += f.area;
-  if (out.face.empty() || !(area > 0)) throw InputError("the mesh has no matched shroud_high/shroud_low node pairs");
-  out.pairs = contact_pairs(mesh, out.face, partition_face(mesh, out.face, 0), ContactDiscretization::nodes,
-                            settings.frame_angle);
-  for (const auto& f : out.face) {
+  try {
+    out.springs = face_springs(mesh, out.face, settings.normal_stiffness, settings.tangential_stiffness,
+                               settings.frame_angle);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  for (const auto& sp : out.springs) {
     contact::StaticPairParameters p;
-    p.normal_stiffness = settings.normal_stiffness * f.area / area;
-    p.tangential_stiffness = settings.tangential_stiffness * f.area / area;
+    p.normal_stiffness = sp.stiffness[2];
+    p.tangential_stiffness = sp.stiffness[0];
     p.friction_coefficient = settings.friction_coefficient;
     p.interference = settings.interference;
     out.parameters.push_back(p);
@@ -68,7 +70,7 @@ void StaticShroudSolver::step_to(double speed_rad_s) {
   if (factor.compute(K0) != linalg::FactorStatus::Success)
     throw NumericalError("static shroud contact " + at.str() + ": K_0 + Omega^2 D is not positive definite (" +
                          linalg::to_string(factor.status()) + ")");
-  const SparseMatrixD B = SparseMatrixD(contact_rows(out_.pairs, sector, 0, mesh_.n_dofs()).real()) * T0;
+  const SparseMatrixD B = SparseMatrixD(sector.interface_rows(0, out_.springs).real()) * T0;
   const Eigen::MatrixXd X = factor.solve(Eigen::MatrixXd(B.transpose()));  // n_red x 3P
   const Eigen::MatrixXd C = B * X;
   const Eigen::MatrixXd Cs = 0.5 * (C + C.transpose());

@@ -10,8 +10,8 @@
 // prestress scale with it); at step k the sector's stiffness is K + Omega_k^2 D (the
 // rotating stiffness of modal/rotating.hpp, prestress from the open-shroud static solution)
 // and the contact problem g = g_ext - C F(g) (contact/static_contact.hpp) is solved with
-// the exact static flexibility C = B K_0^-1 B^T of the pairs (B: frf::contact_rows at
-// h = 0) and g_ext = B K_0^-1 T_0^T Omega_k^2 f1. At zero speed one step applies the
+// the exact static flexibility C = B K_0^-1 B^T of the pairs (B: the springs' relative
+// displacement rows at h = 0, CyclicSector::interface_rows) and g_ext = B K_0^-1 T_0^T Omega_k^2 f1. At zero speed one step applies the
 // interference alone.
 //
 // Usage:
@@ -40,8 +40,10 @@ struct StaticShroudSettings {
 
 struct StaticShroud {
   std::vector<ShroudFaceNode> face;                     ///< one element per face pair
-  std::vector<SectorContactPair> pairs;                 ///< their frames and nodes
-  std::vector<contact::StaticPairParameters> parameters;
+  /// One per face pair (face_springs): nodes, frame and stiffness; tied, they are the
+  /// linear model's springs of the closed pairs (modal.shroud = "contact").
+  std::vector<cyclic::InterfaceSpring> springs;
+  std::vector<contact::StaticPairParameters> parameters;  ///< the springs' kn, kt, with mu and delta
   std::vector<contact::StaticPairResult> results;       ///< at the final speed
   Eigen::VectorXd displacement;                         ///< all 3 n_nodes sector DOFs [m]
   int increments = 0, newton_iterations = 0;

@@ -159,6 +159,12 @@ struct Case {
   /// Where each key came from: "file:line:col" or "file: --set key=value" (for messages
   /// of later stages about a key's value, e.g. a mesh that fails its checks).
   std::map<std::string, std::string> locations;  ///< [expect]: regression expectations (free keys)
+  /// "file:line:col" (or "file: --set key=value") of a key when known, else the case file:
+  /// the head of a later stage's message about that key.
+  std::string where(const std::string& key) const {
+    const auto it = locations.find(key);
+    return it != locations.end() ? it->second : file.string();
+  }
   /// The case as run (after --set and defaults), as TOML text, and as JSON text.
   std::string resolved_toml;
   std::string resolved_json;

@@ -197,6 +197,16 @@ def main():
         with open(os.path.join(work, "meshes", "gen.msh")) as f:
             mesh_text = f.read()
 
+        def run_mutated(kind, i, case, command, mutated, kept_name):
+            """Runs one mutated input; a failure is recorded and, with --keep, the input kept."""
+            err = check_run(exe, work, case, f"{kind} {i}", command)
+            counts[kind] = counts.get(kind, 0) + 1
+            if err:
+                failures.append(err)
+                if a.keep:
+                    os.makedirs(a.keep, exist_ok=True)
+                    shutil.copy(mutated, os.path.join(a.keep, kept_name))
+
         for i in range(a.cases):
             rng = random.Random(f"{a.seed}:case:{i}")
             text = LUMPED
@@ -205,26 +215,15 @@ def main():
             path = os.path.join(work, "c.toml")
             with open(path, "w", errors="replace") as f:
                 f.write(text)
-            err = check_run(exe, work, "c.toml", f"case {i}", "frf")
-            counts["case"] = counts.get("case", 0) + 1
-            if err:
-                failures.append(err)
-                if a.keep:
-                    os.makedirs(a.keep, exist_ok=True)
-                    shutil.copy(path, os.path.join(a.keep, f"case_{i}.toml"))
+            run_mutated("case", i, "c.toml", "frf", path, f"case_{i}.toml")
         with open(os.path.join(work, "s.toml"), "w") as f:
             f.write(SECTOR)
         for i in range(a.meshes):
             rng = random.Random(f"{a.seed}:mesh:{i}")
-            with open(os.path.join(work, "m.msh"), "w") as f:
+            path = os.path.join(work, "m.msh")
+            with open(path, "w") as f:
                 f.write(mutate_mesh(mesh_text, rng))
-            err = check_run(exe, work, "s.toml", f"mesh {i}", "mesh")
-            counts["mesh"] = counts.get("mesh", 0) + 1
-            if err:
-                failures.append(err)
-                if a.keep:
-                    os.makedirs(a.keep, exist_ok=True)
-                    shutil.copy(os.path.join(work, "m.msh"), os.path.join(a.keep, f"mesh_{i}.msh"))
+            run_mutated("mesh", i, "s.toml", "mesh", path, f"mesh_{i}.msh")
     finally:
         shutil.rmtree(work, ignore_errors=True)
     print(f"fuzz: {counts.get('case', 0)} mutated cases, {counts.get('mesh', 0)} mutated meshes, "
