@@ -46,6 +46,7 @@ bool ArclengthOptions::validate(int n, std::vector<std::string>* errors) const {
   if (!(initial_step > 0 && std::isfinite(initial_step))) e.push_back("initial_step > 0");
   if (!(min_step > 0 && min_step < 1)) e.push_back("0 < min_step < 1");
   if (!(max_step >= 1 && std::isfinite(max_step))) e.push_back("max_step >= 1");
+  if (!(max_lambda_step >= 0 && std::isfinite(max_lambda_step))) e.push_back("max_lambda_step >= 0 (0: none)");
   if (!(max_turn_deg > 0 && max_turn_deg < 180)) e.push_back("0 < max_turn_deg < 180");
   if (!(target_turn_deg > 0 && target_turn_deg <= max_turn_deg)) e.push_back("0 < target_turn_deg <= max_turn_deg");
   if (!(kink_step > 0 && kink_step <= 1)) e.push_back("0 < kink_step <= 1");
@@ -160,6 +161,10 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
   while (static_cast<int>(branch.points.size()) < o.max_points) {
     // Predictor and corrector.
     double h = steps.step();
+    if (o.max_lambda_step > 0 && std::abs(t[n]) * h > o.max_lambda_step) {
+      steps.set(o.max_lambda_step / std::abs(t[n]));  // a rejection halves from here
+      h = steps.step();
+    }
     const Eigen::VectorXd y_pred = y + h * t;
     Eigen::VectorXd y_new = y_pred, t_new;
     double rnorm = 0.0;

@@ -80,6 +80,11 @@ struct ArclengthOptions {
   double initial_step = 0.5;      ///< arclength, scaled units
   double min_step = 1e-6;         ///< relative to initial_step: stop when the step falls below
   double max_step = 20.0;         ///< relative to initial_step
+  /// Largest change of lambda per step, scaled units (0: none). The arclength step is cut so
+  /// that |t_lambda| h stays below it: the frequency resolution is bounded where the branch
+  /// moves along lambda, while where it moves in x (a resonance's phase turning) the step is
+  /// bounded by max_step and the turn of the tangent only.
+  double max_lambda_step = 0.0;
   int max_points = 5000;
   double tolerance = 1e-8;        ///< on the scaled residual, infinity norm
   int max_newton_iterations = 15;

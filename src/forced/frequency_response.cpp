@@ -186,7 +186,8 @@ continuation::ArclengthOptions arclength_options(const FrequencyResponseSettings
   ao.x_scale = Eigen::VectorXd::Constant(equations.size(), x_unit);
   const double requested = s.initial_step_hz > 0 ? s.initial_step_hz / lambda_unit : kAutoInitialStep;
   ao.initial_step = std::min(requested, kMaxStep);
-  ao.max_step = kMaxStep / ao.initial_step;
+  ao.max_step = kMaxArcStep / ao.initial_step;
+  ao.max_lambda_step = kMaxStep;
   ao.max_points = s.max_points;
   ao.tolerance = s.tolerance;
   return ao;

@@ -47,7 +47,8 @@ struct FrequencyResponseSettings {
 constexpr double kRangeUnits = 100.0;
 constexpr double kFreePeakUnits = 20.0;
 constexpr double kAutoInitialStep = 0.25;  ///< units
-constexpr double kMaxStep = 0.5;           ///< units: at least kRangeUnits / kMaxStep points
+constexpr double kMaxStep = 0.5;           ///< units of lambda per step: at least kRangeUnits / kMaxStep points
+constexpr double kMaxArcStep = 20.0;       ///< arclength units per step (a free peak's motion)
 
 /// The largest free contact motion over the range (41 samples and every resonance inside).
 double free_motion_peak(const frf::LinearPart& linear, const ReducedEquations& equations, double f_start, double f_end);
