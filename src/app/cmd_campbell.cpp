@@ -15,7 +15,7 @@
 
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
-#include "app/workers.hpp"
+#include "linalg/parallel.hpp"
 #include "campbell/campbell.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -145,9 +145,9 @@ int cmd_campbell(Context& ctx) {
               fixed(peak_top / 1e6, 1) + " MPa (element " + std::to_string(ops.peak.element) +
               "), largest displacement " + fixed(tip_top * 1e3, 3) + " mm (" + fixed(prestress_seconds, 2) + " s)");
 
-    const int workers = worker_count(ctx.threads, static_cast<int>(canonical.size()));
+    const int workers = linalg::worker_count(ctx.threads, static_cast<int>(canonical.size()));
     std::mutex lock;
-    parallel_for(static_cast<int>(canonical.size()), workers, [&](int k) {
+    linalg::parallel_for(static_cast<int>(canonical.size()), workers, [&](int k) {
       {
         const int h = canonical[k];
         campbell::HarmonicSweep s = campbell::sweep_harmonic(sweep_sector, rot, h, rpm, model.options, at_rest(h),

@@ -17,14 +17,12 @@
 
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
-#include "app/workers.hpp"
+#include "linalg/parallel.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "fe/assembly.hpp"
-#include "fe/fingerprint.hpp"
 #include "frf/contact_patches.hpp"
 #include "io/output.hpp"
-#include "modal/cache.hpp"
+#include "modal/modal_stage.hpp"
 #include "modal/harmonic.hpp"
 #include "modal/rotating.hpp"
 
@@ -45,58 +43,6 @@ std::string fixed(double v, int digits) {
   s << v;
   return s.str();
 }
-
-// Version tags: bump when the meaning of a cached entry changes.
-constexpr const char* kMatricesVersion = "fe-km/1";
-constexpr const char* kModesVersion = "modes/1";
-
-std::string matrices_key(const mesh::Mesh& m, const fe::Material& mat) {
-  fe::Hasher h;
-  h.add(std::string(kMatricesVersion));
-  fe::hash_into(h, m);
-  fe::hash_into(h, mat);
-  return h.hex();
-}
-
-// Speed 0 keeps the key of the modes at rest; a speed adds the rotating-effects tag and Omega.
-constexpr const char* kRotatingVersion = "rotating/1";
-
-constexpr const char* kInterfaceVersion = "interface/1";
-
-std::string modes_key(const std::string& km_key, int h, const modal::ModalOptions& o, double speed_rpm,
-                      const std::vector<cyclic::InterfaceSpring>& springs) {
-  fe::Hasher hs;
-  hs.add(std::string(kModesVersion));
-  hs.add(km_key);
-  // The open shroud keeps the key it always had; springs add their nodes, frames, stiffnesses.
-  if (!springs.empty()) {
-    hs.add(std::string(kInterfaceVersion));
-    for (const auto& sp : springs) {
-      hs.add(sp.high_node);
-      hs.add(sp.low_node);
-      for (int i = 0; i < 9; ++i) hs.add(sp.frame(i));
-      for (int i = 0; i < 3; ++i) hs.add(sp.stiffness[i]);
-    }
-  }
-  if (speed_rpm > 0.0) {
-    hs.add(std::string(kRotatingVersion));
-    hs.add(speed_rpm);
-  }
-  hs.add(h);
-  hs.add(o.modes);
-  hs.add(o.shift);
-  hs.add(o.tolerance);
-  hs.add(o.residual_tolerance);
-  hs.add(modal::to_string(o.method));
-  return hs.hex();
-}
-
-// Modes of one canonical harmonic index (h <= Nb/2), solved or from the cache.
-struct HarmonicOutcome {
-  modal::ModalResult result;
-  bool reused = false;
-  double seconds = 0.0;
-};
 
 }  // namespace
 
@@ -173,30 +119,13 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   if (shroud == Shroud::stuck) model.interface = shroud_springs(c, model.mesh);
 
   // K and M.
+  const modal::StageCache cache{cache_dir, [&ctx](const std::string& m) { ctx.report.warn(m); }};
+  modal::CachedMatrices matrices = modal::cached_matrices(model.mesh, model.material, cache, ctx.threads);
+  model.km = std::move(matrices.km);
+  const std::string& km_key = matrices.key;
+  const bool km_reused = matrices.reused;
+  const double km_seconds = matrices.seconds;
   log::Stopwatch clock;
-  const std::string km_key = matrices_key(model.mesh, model.material);
-  const fs::path km_file = cache_dir / ("km-" + km_key + ".bin");
-  bool km_reused = false;
-  std::string km_problem;
-  auto cached_km = modal::load_matrices(km_file, km_key, &km_problem);
-  if (cached_km && (cached_km->K.rows() != model.mesh.n_dofs() || cached_km->M.rows() != model.mesh.n_dofs())) {
-    km_problem = "its matrices do not match the mesh";
-    cached_km.reset();
-  }
-  if (!km_problem.empty())
-    ctx.report.warn("cache entry " + km_file.string() + " is corrupt (" + km_problem + "); recomputing");
-  if (cached_km) {
-    model.km = std::move(*cached_km);
-    km_reused = true;
-  } else {
-    model.km = fe::assemble(model.mesh, model.material, ctx.threads);
-    try {
-      modal::save_matrices(km_file, km_key, model.km);
-    } catch (const std::exception& e) {
-      ctx.report.warn(std::string("could not cache K and M: ") + e.what());
-    }
-  }
-  const double km_seconds = clock.seconds();
   ctx.report.stage("assembly", km_seconds, km_reused);
   report["matrices"] = {{"key", km_key}, {"reused", km_reused}, {"seconds", km_seconds},
                         {"dofs", model.mesh.n_dofs()}, {"stored_entries_K", model.km.K.nonZeros()}};
@@ -257,68 +186,16 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   canonical.erase(std::unique(canonical.begin(), canonical.end()), canonical.end());
 
   clock.restart();
-  std::map<int, HarmonicOutcome> outcome;
-  std::vector<int> to_solve;
-  for (int h : canonical) {
-    const std::string key = modes_key(km_key, h, model.options, speed_rpm, model.interface);
-    const fs::path f = cache_dir / ("modes-" + key + ".bin");
-    std::string problem;
-    auto cached = modal::load_basis(f, key, &problem);
-    if (cached && (cached->harmonic_index != h || cached->size() != model.options.modes)) {
-      problem = "its modes do not match the harmonic index or the mode count";
-      cached.reset();
-    }
-    if (!problem.empty()) ctx.report.warn("cache entry " + f.string() + " is corrupt (" + problem + "); recomputing");
-    if (cached) {
-      HarmonicOutcome& o = outcome[h];
-      o.reused = true;
-      o.result.basis = std::move(*cached);
-      o.result.report.method = "cache";
-    } else {
-      to_solve.push_back(h);
-    }
-  }
-  if (!to_solve.empty()) {
-    const cyclic::CyclicSector& sector = model.cyclic();
-    report["reduced_dofs"] = sector.n_reduced();
-    // Harmonic indices are independent: solve them in parallel (each worker holds one
-    // factorization; CHOLMOD, Spectra and Eigen objects are not shared).
-    const int workers = worker_count(ctx.threads, static_cast<int>(to_solve.size()));
-    std::mutex lock;
-    parallel_for(static_cast<int>(to_solve.size()), workers, [&](int i) {
-      {
-        const int h = to_solve[i];
-        log::Stopwatch watch;
-        HarmonicOutcome o;
-        try {
-          o.result = modal::solve_harmonic(sector, h, model.options);
-        } catch (const std::exception& e) {
-          o.result.report.status = modal::ModalStatus::NotConverged;
-          o.result.report.message = e.what();
-        }
-        o.seconds = watch.seconds();
-        if (!keep_factors) o.result.stiffness = modal::StiffnessFactor();  // free the factor now
-        const auto& r = o.result.report;
-        std::string line = "modes h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
-        if (r.ok()) {
-          const Eigen::VectorXd f = o.result.basis.frequency_hz();
-          line += std::to_string(f.size()) + " modes, " + fixed(f(0), 2) + " .. " + fixed(f(f.size() - 1), 2) +
-                  " Hz (" + r.method + ", factor " + fixed(r.factor_seconds, 2) + " s, Lanczos " +
-                  fixed(r.solve_seconds, 2) + " s, " + std::to_string(r.operations) + " solves)";
-        } else {
-          line += "FAILED: " + modal::to_string(r.status) + ": " + r.message;
-        }
-        log::info(line);
-        std::lock_guard<std::mutex> g(lock);
-        outcome[h] = std::move(o);
-      }
-    });
-  }
+  std::map<int, modal::CachedModes> outcome =
+      modal::cached_modes([&model]() -> const cyclic::CyclicSector& { return model.cyclic(); }, km_key, canonical,
+                          model.options, speed_rpm, model.interface, cache, ctx.threads, keep_factors);
+  if (std::any_of(outcome.begin(), outcome.end(), [](const auto& o) { return !o.second.reused; }))
+    report["reduced_dofs"] = model.cyclic().n_reduced();  // built for the solves
 
   bool all_reused = true;
   nlohmann::json per_h = nlohmann::json::array();
   for (int h : canonical) {
-    HarmonicOutcome& o = outcome.at(h);
+    modal::CachedModes& o = outcome.at(h);
     const auto& r = o.result.report;
     all_reused = all_reused && o.reused;
     nlohmann::json entry = {{"harmonic_index", h}, {"nodal_diameter", cyclic::nodal_diameter(h, nb)},
@@ -344,14 +221,6 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
       continue;
     }
     if (!r.message.empty()) ctx.report.warn("harmonic index " + std::to_string(h) + ": " + r.message);
-    if (!o.reused) {
-      try {
-        const std::string key = modes_key(km_key, h, model.options, speed_rpm, model.interface);
-        modal::save_basis(cache_dir / ("modes-" + key + ".bin"), key, o.result.basis);
-      } catch (const std::exception& e) {
-        ctx.report.warn(std::string("could not cache modes: ") + e.what());
-      }
-    }
     if (keep_factors && o.result.stiffness.valid()) model.factors[h] = o.result.stiffness;
     o.result.stiffness = modal::StiffnessFactor();  // released here unless kept
   }
@@ -359,7 +228,7 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   report["solved"] = per_h;
   for (int h : harmonic_indices) {
     const int hc = std::min(h, (nb - h) % nb);
-    const HarmonicOutcome& o = outcome.at(hc);
+    const modal::CachedModes& o = outcome.at(hc);
     if (!o.result.report.ok()) continue;
     model.bases[h] = h == hc ? o.result.basis : o.result.basis.conjugate(h);
   }

@@ -20,7 +20,7 @@
 #include "app/context.hpp"
 #include "app/frf_curves.hpp"
 #include "app/modal_stage.hpp"
-#include "app/workers.hpp"
+#include "linalg/parallel.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
@@ -62,14 +62,14 @@ double thread_cpu_seconds() {
 /// quietly, one line each; fills status, message, peak, points and seconds. Returns the
 /// number of workers used.
 int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<StudyPoint>& points) {
-  const int workers = worker_count(ctx.threads, static_cast<int>(points.size()));
+  const int workers = linalg::worker_count(ctx.threads, static_cast<int>(points.size()));
   log::info("study: " + std::to_string(points.size()) + " points on " + std::to_string(workers) + " workers");
   const bool verbose = log::verbose();
   log::set_verbose(false);  // points run quietly; one line each below
   std::mutex out;
   // Serial BLAS even with one worker: a point's cost is its thread's CPU time.
   linalg::SerialBlasScope serial;
-  parallel_for(static_cast<int>(points.size()), workers, [&](int i) {
+  linalg::parallel_for(static_cast<int>(points.size()), workers, [&](int i) {
     {
       Context pc;
       pc.config = cases[i];

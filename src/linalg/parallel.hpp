@@ -1,9 +1,9 @@
 #pragma once
-// The worker pool of the commands that run independent jobs in parallel (harmonic indices
+// The worker pool for independent jobs run in parallel (harmonic indices
 // in `modes` and `campbell`, points in `study`).
 //
-//   const int workers = app::worker_count(ctx.threads, jobs);
-//   app::parallel_for(jobs, workers, [&](int i) { ...job i... });
+//   const int workers = linalg::worker_count(ctx.threads, jobs);
+//   linalg::parallel_for(jobs, workers, [&](int i) { ...job i... });
 //
 // Each index runs once, on one of `workers` threads (the calling thread included), taken in
 // increasing order. With more than one worker the BLAS runs on one thread meanwhile
@@ -20,7 +20,7 @@
 
 #include "linalg/blas.hpp"
 
-namespace shroudsim::app {
+namespace shroudsim::linalg {
 
 /// `requested` workers (0: one per hardware thread), at least 1 and at most `jobs`.
 inline int worker_count(int requested, int jobs) {
@@ -55,4 +55,4 @@ void parallel_for(int jobs, int workers, Job&& job) {
   if (failure) std::rethrow_exception(failure);
 }
 
-}  // namespace shroudsim::app
+}  // namespace shroudsim::linalg
