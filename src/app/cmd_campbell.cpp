@@ -20,6 +20,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
+#include "io/vtu.hpp"
 #include "frf/static_shroud.hpp"
 #include "modal/rotating.hpp"
 
@@ -138,7 +139,7 @@ int cmd_campbell(Context& ctx) {
       Eigen::MatrixXd disp(model.mesh.n_nodes(), 3);
       for (int n = 0; n < model.mesh.n_nodes(); ++n) disp.row(n) = w2 * ops.displacement.segment<3>(3 * n).transpose();
       const Eigen::VectorXd vm = w2 * fe::nodal_von_mises(model.mesh, model.material, ops.displacement);
-      write_point_fields_vtu(ctx, model.mesh, "prestress.vtu",
+      io::write_point_fields_vtu(ctx.out_dir / "prestress.vtu", model.mesh,
                              {{"centrifugal_displacement_m", disp}, {"von_mises_pa", Eigen::MatrixXd(vm)}});
     }
     log::info("campbell: centrifugal prestress at " + io::format_number(s1) + " rpm: peak von Mises " +

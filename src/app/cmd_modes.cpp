@@ -22,6 +22,7 @@
 #include "core/log.hpp"
 #include "frf/contact_patches.hpp"
 #include "io/output.hpp"
+#include "io/vtu.hpp"
 #include "modal/modal_stage.hpp"
 #include "modal/harmonic.hpp"
 #include "modal/rotating.hpp"
@@ -247,92 +248,6 @@ void write_modes_csv(Context& ctx, const ModalModel& model) {
   io::write_file_atomic(ctx.out_dir / "modes.csv", s.str());
 }
 
-namespace {
-
-std::string base64(const std::vector<std::uint8_t>& data) {
-  static constexpr char kTable[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((data.size() + 2) / 3 * 4);
-  std::size_t i = 0;
-  for (; i + 2 < data.size(); i += 3) {
-    const std::uint32_t v = (data[i] << 16) | (data[i + 1] << 8) | data[i + 2];
-    out += kTable[(v >> 18) & 63];
-    out += kTable[(v >> 12) & 63];
-    out += kTable[(v >> 6) & 63];
-    out += kTable[v & 63];
-  }
-  if (i < data.size()) {
-    std::uint32_t v = data[i] << 16;
-    if (i + 1 < data.size()) v |= data[i + 1] << 8;
-    out += kTable[(v >> 18) & 63];
-    out += kTable[(v >> 12) & 63];
-    out += i + 1 < data.size() ? kTable[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-  return out;
-}
-
-// VTK XML inline binary: a UInt32 byte count, then the data, base64-encoded together.
-template <typename T>
-std::string vtk_binary(const std::vector<T>& values) {
-  const std::uint32_t bytes = static_cast<std::uint32_t>(values.size() * sizeof(T));
-  std::vector<std::uint8_t> buf(sizeof bytes + bytes);
-  std::memcpy(buf.data(), &bytes, sizeof bytes);
-  if (bytes) std::memcpy(buf.data() + sizeof bytes, values.data(), bytes);
-  return base64(buf);
-}
-
-// The VTU tail after the point data: points, cells (4- or 10-node tets), closing tags.
-std::string vtu_points_and_cells(const mesh::Mesh& m) {
-  const int npe = m.nodes_per_element();
-  std::ostringstream s;
-  s << "</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">\n";
-  std::vector<double> xyz(m.nodes.data(), m.nodes.data() + m.nodes.size());  // row-major n x 3
-  s << vtk_binary(xyz) << "\n</DataArray>\n</Points>\n<Cells>\n";
-  // VTK quadratic tetra: edges (0,1) (1,2) (0,2) (0,3) (1,3) (2,3); gmsh: ... (2,3) (1,3).
-  static constexpr int kGmshToVtk10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
-  std::vector<std::int32_t> conn, offsets;
-  std::vector<std::uint8_t> types;
-  for (int e = 0; e < m.n_elements(); ++e) {
-    for (int a = 0; a < npe; ++a) conn.push_back(m.tets(e, npe == 10 ? kGmshToVtk10[a] : a));
-    offsets.push_back(static_cast<std::int32_t>(conn.size()));
-    types.push_back(npe == 10 ? 24 : 10);
-  }
-  s << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"binary\">\n" << vtk_binary(conn) << "\n</DataArray>\n"
-    << "<DataArray type=\"Int32\" Name=\"offsets\" format=\"binary\">\n" << vtk_binary(offsets) << "\n</DataArray>\n"
-    << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n" << vtk_binary(types) << "\n</DataArray>\n"
-    << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  return s.str();
-}
-
-std::string vtu_head(const mesh::Mesh& m) {
-  std::ostringstream s;
-  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-       "header_type=\"UInt32\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
-    << m.n_nodes() << "\" NumberOfCells=\"" << m.n_elements() << "\">\n<PointData>\n";
-  return s.str();
-}
-
-}  // namespace
-
-void write_point_fields_vtu(Context& ctx, const mesh::Mesh& mesh, const std::string& file,
-                            const std::vector<PointField>& fields) {
-  std::ostringstream s;
-  s << vtu_head(mesh);
-  for (const auto& f : fields) {
-    SHROUDSIM_CHECK(f.values.rows() == mesh.n_nodes() && (f.values.cols() == 1 || f.values.cols() == 3),
-                    "write_point_fields_vtu: a field needs n_nodes rows and 1 or 3 columns");
-    std::vector<float> v;
-    v.reserve(f.values.size());
-    for (Eigen::Index n = 0; n < f.values.rows(); ++n)
-      for (Eigen::Index c = 0; c < f.values.cols(); ++c) v.push_back(static_cast<float>(f.values(n, c)));
-    s << "<DataArray type=\"Float32\" Name=\"" << f.name << "\" NumberOfComponents=\"" << f.values.cols()
-      << "\" format=\"binary\">\n" << vtk_binary(v) << "\n</DataArray>\n";
-  }
-  s << vtu_points_and_cells(mesh);
-  io::write_file_atomic(ctx.out_dir / file, s.str());
-}
-
 void write_modes_vtu(Context& ctx, ModalModel& model) {
   const mesh::Mesh& m = model.mesh;
   // Field budget: at most 256 MiB of float32 point data.
@@ -345,8 +260,7 @@ void write_modes_vtu(Context& ctx, ModalModel& model) {
     ctx.report.warn("modes.vtu holds the first " + std::to_string(per_h_cap) +
                     " modes of each harmonic index (file size limit of 256 MiB)");
 
-  std::ostringstream s;
-  s << vtu_head(m);
+  io::VtuBuilder vtu(m);
   const cyclic::CyclicSector& sector = model.cyclic();
   for (const auto& [h, b] : model.bases) {
     const Eigen::VectorXd f = b.frequency_hz();
@@ -360,12 +274,12 @@ void write_modes_vtu(Context& ctx, ModalModel& model) {
       const double scale = re.cwiseAbs().maxCoeff() > 0 ? 1.0 / re.cwiseAbs().maxCoeff() : 1.0;
       std::vector<float> v(re.size());
       for (Eigen::Index i = 0; i < re.size(); ++i) v[i] = static_cast<float>(re(i) * scale);
-      s << "<DataArray type=\"Float32\" Name=\"h" << h << "_mode" << r + 1 << "_" << fixed(f(r), 1)
-        << "Hz\" NumberOfComponents=\"3\" format=\"binary\">\n" << vtk_binary(v) << "\n</DataArray>\n";
+      std::ostringstream name;
+      name << 'h' << h << "_mode" << r + 1 << '_' << fixed(f(r), 1) << "Hz";
+      vtu.add(name.str(), v, 3);
     }
   }
-  s << vtu_points_and_cells(m);
-  io::write_file_atomic(ctx.out_dir / "modes.vtu", s.str());
+  io::write_file_atomic(ctx.out_dir / "modes.vtu", vtu.finish());
 }
 
 void draw_plots(Context& ctx) {

@@ -14,6 +14,7 @@
 #include "fe/rotating.hpp"
 #include "frf/static_shroud.hpp"
 #include "io/output.hpp"
+#include "io/vtu.hpp"
 #include "modal/rotating.hpp"
 
 namespace shroudsim::app {
@@ -76,7 +77,7 @@ int cmd_static(Context& ctx) {
   for (int n = 0; n < m.n_nodes(); ++n) disp.row(n) = st.displacement.segment<3>(3 * n).transpose();
   const Eigen::VectorXd vm = fe::nodal_von_mises(m, model.material, st.displacement);
   const fe::PeakStress peak = fe::peak_von_mises(m, model.material, st.displacement);
-  write_point_fields_vtu(ctx, m, "contact_static.vtu",
+  io::write_point_fields_vtu(ctx.out_dir / "contact_static.vtu", m,
                          {{"displacement_m", disp}, {"von_mises_pa", Eigen::MatrixXd(vm)},
                           {"contact_pressure_pa", pressure}, {"contact_state", state}});
 

@@ -89,14 +89,6 @@ void write_modes_csv(Context& ctx, const ModalModel& model);
 /// the real part of the mode shape on every node (cyclic_high included) after turning its
 /// phase so that the largest component is real.
 void write_modes_vtu(Context& ctx, ModalModel& model);
-/// One point-data field of a VTU file: n_nodes rows, 1 (scalar) or 3 (vector) columns.
-struct PointField {
-  std::string name;
-  Eigen::MatrixXd values;
-};
-/// <result folder>/<file>: the mesh (4- or 10-node tets) with the given point-data fields.
-void write_point_fields_vtu(Context& ctx, const mesh::Mesh& mesh, const std::string& file,
-                            const std::vector<PointField>& fields);
 /// Runs tools/plot.py on the result folder when /usr/bin/python3 has matplotlib; otherwise
 /// says that plots are skipped. A plotting failure is a warning, not an error.
 void draw_plots(Context& ctx);
