@@ -12,7 +12,7 @@
 
 #include "app/context.hpp"
 #include "app/forced_stage.hpp"
-#include "app/frf_curves.hpp"
+#include "study/curves.hpp"
 #include "app/modal_stage.hpp"
 #include "continuation/arclength.hpp"
 #include "core/error.hpp"
@@ -105,7 +105,7 @@ int frf_auto(Context& ctx) {
   const forced::DiscretizationTrial& chosen = search.trials[search.chosen];
   const std::filesystem::path& chosen_dir = dirs[search.chosen];
   for (const char* f : {"frf.csv", "loops.csv", "peaks.csv"})
-    if (std::filesystem::exists(chosen_dir / f)) io::write_file_atomic(ctx.out_dir / f, read_file(chosen_dir / f));
+    if (std::filesystem::exists(chosen_dir / f)) io::write_file_atomic(ctx.out_dir / f, study::read_file(chosen_dir / f));
   ctx.frf_curve = chosen.curve;
   ctx.report.section("frf") = frf_sections[search.chosen];
   const double tol = settings.tolerance;

@@ -18,7 +18,8 @@
 #include <thread>
 
 #include "app/context.hpp"
-#include "app/frf_curves.hpp"
+#include "study/curves.hpp"
+#include "study/trade_design.hpp"
 #include "app/modal_stage.hpp"
 #include "linalg/parallel.hpp"
 #include "core/error.hpp"
@@ -119,68 +120,16 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
 }
 
 
-/// The mesh ladder of `study --convergence`: kMeshLadder sizes, each kMeshRatio times finer
-/// (about twice the DOFs of the one before).
-constexpr int kMeshLadder = 4;
-const double kMeshRatio = std::cbrt(2.0);
-
 /// `study --convergence`: every knob of the accuracy/speed trade varied one at a time around
 /// the case's own setting, each against its finest value (the reference), with every other
-/// knob at the case's setting. The error of a point is peaks_change (frf_curves.hpp) between
+/// knob at the case's setting. The error of a point is peaks_change (study/curves.hpp) between
 /// its curve and the reference's (the largest relative change at any resonance peak of the
 /// range) and peaks_shift_hz (the largest shift of such a peak); its cost is its wall time (a run
 /// that has to build a new mesh and its modes pays for them). -> trade.csv, trade.png.
 int run_convergence(Context& ctx) {
   const io::Case& c = ctx.config;
-  const bool sector = c.structure.type == "sector";
   auto num = [](double v) { return io::format_number(v); };
-  auto quoted = [](const std::string& v) { return "\"" + v + "\""; };
-  struct Knob {
-    std::string name, key;
-    std::vector<std::string> values;  ///< TOML value texts, coarse to fine
-    std::vector<std::pair<std::string, std::string>> reference;  ///< overrides of the reference point
-  };
-  std::vector<Knob> knobs;
-  if (sector && c.structure.mesh.empty()) {
-    // Four sizes, each with about twice the DOFs of the one before (h / 2^(1/3)): enough to
-    // see the observed order and extrapolate (mesh_convergence in run.json).
-    const double m = c.geometry.mesh_size;
-    std::vector<std::string> sizes;
-    for (int i = 0; i < kMeshLadder; ++i) sizes.push_back(num(m * std::pow(kMeshRatio, -i)));
-    knobs.push_back({"mesh size [m]", "geometry.mesh_size", sizes, {}});
-  }
-  if (sector && c.contact.pairs != 0) {
-    // The case's contact elements against one per shroud node pair (at the case's mesh).
-    knobs.push_back({"contact pairs", "contact.pairs", {std::to_string(c.contact.pairs), quoted("all")}, {}});
-  }
-  if (sector) {
-    const int modes = c.modal.modes;
-    knobs.push_back({"modes kept", "modal.modes", {std::to_string(std::max(5, modes / 2)), std::to_string(modes), std::to_string(2 * modes)}, {}});
-    knobs.push_back({"residual flexibility", "modal.residual_flexibility", {"false", "true"}, {}});
-  }
-  const int h = c.hbm.harmonics_auto ? 5 : c.hbm.harmonics;
-  const int n = c.hbm.time_samples_auto ? 512 : c.hbm.time_samples;
-  const bool exact_1d = c.contact.model == "1d_exact";
-  if (!exact_1d) {
-    std::vector<std::string> hs;
-    for (int v : {1, 3, h, 2 * h})
-      if (v >= 1 && 2 * v + 1 <= 4 * n && (hs.empty() || std::to_string(v) != hs.back()) && v <= 200) hs.push_back(std::to_string(v));
-    std::sort(hs.begin(), hs.end(), [](const std::string& a, const std::string& b) { return std::stoi(a) < std::stoi(b); });
-    hs.erase(std::unique(hs.begin(), hs.end()), hs.end());
-    // The finest H needs N >= 2H + 1: the reference runs at 4 N.
-    knobs.push_back({"harmonics H", "hbm.harmonics", hs, {{"hbm.time_samples", std::to_string(4 * n)}}});
-    std::vector<std::string> ns;
-    for (int v : {n / 8, n / 4, n / 2, n, 4 * n})
-      if (v >= std::max(16, 2 * h + 1) && v <= 65536) ns.push_back(std::to_string(v));
-    ns.erase(std::unique(ns.begin(), ns.end()), ns.end());
-    knobs.push_back({"time samples N", "hbm.time_samples", ns, {}});
-    if (c.contact.model == "full3d" || c.contact.model == "quasi3d") {
-      knobs.push_back({"tangential update", "contact.tangential_update", {quoted("radial_return"), quoted("exact_linear")},
-                       {{"hbm.time_samples", std::to_string(4 * n)}}});
-      knobs.push_back({"contact model", "contact.model", {quoted("quasi3d"), quoted("full3d")}, {}});
-    }
-    knobs.push_back({"Jacobian", "hbm.jacobian", {quoted("finite_difference"), quoted("analytic")}, {}});
-  }
+  const std::vector<study::Knob> knobs = study::convergence_knobs(c);
   if (knobs.empty())
     throw InputError(c.file.string() + ": study --convergence: this case has no knob to vary");
 
@@ -252,9 +201,9 @@ int run_convergence(Context& ctx) {
     const bool ok = p.status == 0 && r.status == 0;
     double err = 0.0, ferr = 0.0;
     if (ok) {
-      const auto cp = read_curve(ctx.out_dir / p.folder / "frf.csv"), cr = read_curve(ctx.out_dir / r.folder / "frf.csv");
-      err = peaks_change(cp, cr);
-      ferr = peaks_shift_hz(cp, cr);
+      const auto cp = study::read_curve(ctx.out_dir / p.folder / "frf.csv"), cr = study::read_curve(ctx.out_dir / r.folder / "frf.csv");
+      err = study::peaks_change(cp, cr);
+      ferr = study::peaks_shift_hz(cp, cr);
     }
     std::string value = row.value, ref = reference_label[row.knob];
     for (std::string* t : {&value, &ref}) t->erase(std::remove(t->begin(), t->end(), '"'), t->end());
@@ -278,7 +227,7 @@ int run_convergence(Context& ctx) {
         all_ok = all_ok && points[row.point].status == 0;
       }
     if (!all_ok || peaks.size() < 3) continue;
-    const MeshConvergence mc = mesh_convergence(peaks, kMeshRatio);
+    const study::MeshConvergence mc = study::mesh_convergence(peaks, study::kMeshRatio);
     nlohmann::json j = {{"mesh_sizes_m", sizes}, {"peaks_m", peaks}, {"case_peak_m", peaks.front()},
                         {"finest_peak_m", peaks.back()}, {"monotone", mc.monotone}};
     j["observed_order"] = mc.monotone ? nlohmann::json(mc.order) : nlohmann::json(nullptr);

@@ -1,11 +1,11 @@
-#include "app/frf_curves.hpp"
+#include "study/curves.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
-namespace shroudsim::app {
+namespace shroudsim::study {
 
 std::string read_file(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -47,4 +47,4 @@ MeshConvergence mesh_convergence(const std::vector<double>& peaks, double r) {
   return mc;
 }
 
-}  // namespace shroudsim::app
+}  // namespace shroudsim::study

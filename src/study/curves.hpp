@@ -8,7 +8,7 @@
 
 #include "forced/discretization_search.hpp"
 
-namespace shroudsim::app {
+namespace shroudsim::study {
 
 /// The whole file as text ("" when it cannot be read).
 std::string read_file(const std::filesystem::path& p);
@@ -35,4 +35,4 @@ struct MeshConvergence {
 /// (the case's) value is taken against it.
 MeshConvergence mesh_convergence(const std::vector<double>& values, double r);
 
-}  // namespace shroudsim::app
+}  // namespace shroudsim::study

@@ -1,11 +1,11 @@
-// Richardson extrapolation of `study --convergence`'s mesh ladder (app/frf_curves.hpp).
+// Richardson extrapolation of `study --convergence`'s mesh ladder (study/curves.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "app/frf_curves.hpp"
+#include "study/curves.hpp"
 
-namespace shroudsim::app {
+namespace shroudsim::study {
 namespace {
 
 TEST(MeshConvergence, RecoversOrderAndLimitOfAPowerLaw) {
@@ -34,4 +34,4 @@ TEST(MeshConvergence, OscillatingLadderIsNotExtrapolated) {
 }
 
 }  // namespace
-}  // namespace shroudsim::app
+}  // namespace shroudsim::study
