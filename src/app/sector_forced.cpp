@@ -101,29 +101,14 @@ ForcedModel make_sector_model(Context& ctx) {
   double total = 0.0;
   for (const auto& f : face) total += f.area;
   ForcedModel model;
+  contact::PairParameters totals;
+  totals.friction_coefficient = c.contact.friction_coefficient;
+  totals.tangential_stiffness = c.contact.tangential_stiffness;
+  totals.normal_stiffness = c.contact.normal_stiffness;
+  totals.normal_preload = c.contact.normal_preload;
+  model.pairs = frf::patch_parameters(patches, total, totals, static_state ? &*static_state : nullptr);
   double static_preload = 0.0;
-  for (const auto& p : patches) {
-    const double s = p.area / total;
-    contact::PairParameters pp;
-    pp.friction_coefficient = c.contact.friction_coefficient;
-    pp.tangential_stiffness = c.contact.tangential_stiffness * s;
-    pp.normal_stiffness = c.contact.normal_stiffness * s;
-    pp.normal_preload = c.contact.normal_preload * s;
-    if (static_state) {
-      // The patch's preload is the sum over its node pairs of their static normal loads, an
-      // open pair counting as -kn_i gap_i (so that a fully open patch has the area-weighted
-      // mean gap). The face and the static solve list the node pairs in the same order.
-      pp.normal_preload = 0.0;
-      for (int member : p.members) {
-        const auto& r = static_state->results[static_cast<std::size_t>(member)];
-        pp.normal_preload += r.state == contact::StaticState::open
-                                 ? -static_state->parameters[static_cast<std::size_t>(member)].normal_stiffness * r.gap
-                                 : r.force[2];
-      }
-      static_preload += pp.normal_preload;
-    }
-    model.pairs.push_back(pp);
-  }
+  for (const auto& pp : model.pairs) static_preload += pp.normal_preload;
   frf::SectorForcing forcing;
   forcing.engine_order = m;
   forcing.excitation_node = nearest_node(mesh, c.excitation.point);

@@ -96,4 +96,29 @@ StaticShroud solve_static_shroud(const mesh::Mesh& mesh, const linalg::SparsePai
   return solver.state();
 }
 
+std::vector<contact::PairParameters> patch_parameters(const std::vector<ContactPatch>& patches, double face_area,
+                                                      const contact::PairParameters& face,
+                                                      const StaticShroud* state) {
+  std::vector<contact::PairParameters> out;
+  for (const auto& p : patches) {
+    const double s = p.area / face_area;
+    contact::PairParameters pp;
+    pp.friction_coefficient = face.friction_coefficient;
+    pp.tangential_stiffness = face.tangential_stiffness * s;
+    pp.normal_stiffness = face.normal_stiffness * s;
+    pp.normal_preload = face.normal_preload * s;
+    if (state) {
+      pp.normal_preload = 0.0;
+      for (int member : p.members) {
+        const auto& r = state->results[static_cast<std::size_t>(member)];
+        pp.normal_preload += r.state == contact::StaticState::open
+                                 ? -state->parameters[static_cast<std::size_t>(member)].normal_stiffness * r.gap
+                                 : r.force[2];
+      }
+    }
+    out.push_back(pp);
+  }
+  return out;
+}
+
 }  // namespace shroudsim::frf

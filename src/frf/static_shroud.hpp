@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "contact/contact_law.hpp"
 #include "contact/static_contact.hpp"
 #include "frf/contact_patches.hpp"
 #include "linalg/sparse.hpp"
@@ -81,5 +82,15 @@ class StaticShroudSolver {
 /// step at zero speed: the interference alone).
 StaticShroud solve_static_shroud(const mesh::Mesh& mesh, const linalg::SparsePair<double>& km,
                                  const modal::RotatingOperators* ops, const StaticShroudSettings& settings);
+
+/// The contact element of each patch of the forced response (docs/physics.md sections 3 and
+/// 8): the face's totals `face` (friction coefficient, kt, kn, preload) with kt, kn and the
+/// preload times the patch's share A_P / face_area. With `state` (contact.normal_preload =
+/// "static"), the preload is instead the sum over the patch's node pairs of their static normal
+/// loads, an open pair counting as -kn_i gap_i (a fully open patch then has the area-weighted
+/// mean gap); the patches' members index the face, listed in the static solve's order.
+std::vector<contact::PairParameters> patch_parameters(const std::vector<ContactPatch>& patches, double face_area,
+                                                      const contact::PairParameters& face,
+                                                      const StaticShroud* state);
 
 }  // namespace shroudsim::frf
