@@ -157,6 +157,9 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
   StepControl steps(o);
   const double cos_max_turn = std::cos(o.max_turn_deg * std::numbers::pi / 180.0);
   bool corner_tried = false;
+  // Consecutive accepted steps below kink size before the corner crossing is tried anyway.
+  constexpr int kStallSteps = 25;
+  int tiny_steps = 0;
 
   while (static_cast<int>(branch.points.size()) < o.max_points) {
     // Predictor and corrector.
@@ -287,6 +290,27 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
     }
     emit(false);
     steps.accepted(it, turn);
+
+    // Stall: accepted steps far below kink size that zig-zag between the pieces of a corner
+    // (each turns the tangent, so the step never grows back) are a corner too.
+    if (h < steps.kink() && ++tiny_steps >= kStallSteps) {
+      tiny_steps = 0;
+      Eigen::VectorXd yk, tk;
+      int itk = 0;
+      double rk = 0.0;
+      if (cross_corner(s, y, t, steps.kink(), yk, tk, itk, rk)) {
+        ++branch.kinks_crossed;
+        branch.newton_iterations += itk;
+        const double jump = (yk - y).norm();
+        y = yk;
+        t = tk;
+        push(y, t, itk, jump, rk, PointKind::kRegular);
+        steps.set(std::max(jump, steps.kink()));
+        emit(false);
+      }
+    } else if (h >= steps.kink()) {
+      tiny_steps = 0;
+    }
   }
   std::ostringstream m;
   m << "stopped after max_points = " << o.max_points << " points at lambda = " << s.lambda_of(y);
