@@ -13,6 +13,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "core/format.hpp"
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
 #include "linalg/parallel.hpp"
@@ -25,17 +26,6 @@
 #include "modal/rotating.hpp"
 
 namespace shroudsim::app {
-namespace {
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
-
-}  // namespace
 
 int cmd_campbell(Context& ctx) {
   const io::Case& c = ctx.config;

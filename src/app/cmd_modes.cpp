@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "core/format.hpp"
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
 #include "linalg/parallel.hpp"
@@ -37,13 +38,6 @@ namespace {
 namespace fs = std::filesystem;
 
 
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 }  // namespace
 

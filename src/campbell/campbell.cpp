@@ -1,3 +1,4 @@
+#include "core/format.hpp"
 #include "campbell/campbell.hpp"
 
 #include <algorithm>
@@ -13,14 +14,6 @@
 
 namespace shroudsim::campbell {
 namespace {
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 // Shortest round-trip text of a speed (as the result files write numbers).
 std::string number(double v) {

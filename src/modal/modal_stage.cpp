@@ -1,3 +1,4 @@
+#include "core/format.hpp"
 #include "modal/modal_stage.hpp"
 
 #include <algorithm>
@@ -13,14 +14,6 @@
 
 namespace shroudsim::modal {
 namespace {
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 // Version tags: bump when the meaning of a cached entry changes.
 constexpr const char* kMatricesVersion = "fe-km/1";
