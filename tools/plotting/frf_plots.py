@@ -4,6 +4,8 @@ hysteresis loops of the contact pairs at the peak (from loops.csv)."""
 import csv
 import os
 
+from plotting import result_name
+
 
 def _read_csv(path):
     with open(path, newline="") as f:
@@ -60,7 +62,7 @@ def plot_frf(result_dir):
     ax.set_ylim(bottom=max(min(a) * 1e-3, 1e-14))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    ax.set_title(os.path.basename(os.path.normpath(result_dir)))
+    ax.set_title(result_name(result_dir))
     fig.tight_layout()
     fig.savefig(os.path.join(result_dir, "frf.png"), dpi=110)
     plt.close(fig)

@@ -4,6 +4,8 @@ combination of the other keys."""
 import csv
 import os
 
+from plotting import result_name
+
 
 def plot_study(result_dir):
     import matplotlib.pyplot as plt
@@ -41,7 +43,7 @@ def plot_study(result_dir):
         a.grid(True, which="both", alpha=0.3)
     if others:
         ax.legend(fontsize=7)
-    ax.set_title(os.path.basename(os.path.normpath(result_dir)))
+    ax.set_title(result_name(result_dir))
     fig.tight_layout()
     fig.savefig(os.path.join(result_dir, "study.png"), dpi=110)
     plt.close(fig)
@@ -94,7 +96,7 @@ def plot_trade(result_dir):
     ax.set_ylabel("largest relative change of a resonance peak vs the knob's reference")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    ax.set_title(os.path.basename(os.path.normpath(result_dir)) + ": accuracy against cost, one knob at a time")
+    ax.set_title(result_name(result_dir) + ": accuracy against cost, one knob at a time")
     fig.tight_layout()
     fig.savefig(os.path.join(result_dir, "trade.png"), dpi=110)
     plt.close(fig)
