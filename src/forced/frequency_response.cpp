@@ -8,6 +8,7 @@
 
 #include "continuation/events.hpp"
 #include "core/error.hpp"
+#include "forced/excitation_homotopy.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -72,7 +73,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
         w = step_equations.stuck_solution(f);
         if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
           w = step_equations.stuck_solution(f);
-          if (step_equations.solve_by_excitation_homotopy(f, so, w).status != continuation::BranchStatus::kReachedEnd)
+          if (solve_by_excitation_homotopy(step_equations, f, so, w).status != continuation::BranchStatus::kReachedEnd)
             break;
         }
       } else {
@@ -98,7 +99,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   }
   how = "excitation homotopy";
   start = equations.stuck_solution(f);
-  const continuation::Branch h = equations.solve_by_excitation_homotopy(f, ao, start);
+  const continuation::Branch h = solve_by_excitation_homotopy(equations, f, ao, start);
   if (h.status != continuation::BranchStatus::kReachedEnd)
     throw NumericalError("no solution at the start frequency " + number(f) +
                          " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "linalg/gmres.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -293,65 +294,6 @@ void ReducedEquations::apply_jacobian(const Eigen::VectorXd& z, Eigen::VectorXd&
   y += z.head(size());
 }
 
-bool ReducedEquations::gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op,
-                             const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& precondition,
-                             const Eigen::VectorXd& b, Eigen::VectorXd& d, int& iterations) const {
-  // Right-preconditioned GMRES (M^-1: the LU factors of an earlier augmented matrix),
-  // classical Gram-Schmidt applied twice, Givens rotations on the Hessenberg matrix.
-  const Eigen::Index m = b.size();
-  const int kmax = solver_.krylov_max_iterations;
-  const double beta = b.norm();
-  iterations = 0;
-  if (beta == 0.0) {
-    d.setZero(m);
-    return true;
-  }
-  Eigen::MatrixXd V(m, kmax + 1), Z(m, kmax), H = Eigen::MatrixXd::Zero(kmax + 1, kmax);
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(kmax + 1), cs(kmax), sn(kmax), w(m), hcol(kmax + 1), z(m);
-  V.col(0) = b / beta;
-  g[0] = beta;
-  int k = 0;
-  for (; k < kmax; ++k) {
-    precondition(V.col(k), z);
-    Z.col(k) = z;
-    op(Z.col(k), w);
-    auto basis = V.leftCols(k + 1);
-    hcol.head(k + 1).noalias() = basis.transpose() * w;
-    w.noalias() -= basis * hcol.head(k + 1);
-    const Eigen::VectorXd again = basis.transpose() * w;
-    w.noalias() -= basis * again;
-    hcol.head(k + 1) += again;
-    const double hn = w.norm();
-    H.col(k).head(k + 1) = hcol.head(k + 1);
-    H(k + 1, k) = hn;
-    if (hn > 0) V.col(k + 1) = w / hn;
-    for (int i = 0; i < k; ++i) {
-      const double a = H(i, k), c = H(i + 1, k);
-      H(i, k) = cs[i] * a + sn[i] * c;
-      H(i + 1, k) = -sn[i] * a + cs[i] * c;
-    }
-    const double a = H(k, k), c = H(k + 1, k), rho = std::hypot(a, c);
-    if (!(rho > 0)) return false;
-    cs[k] = a / rho;
-    sn[k] = c / rho;
-    H(k, k) = rho;
-    H(k + 1, k) = 0.0;
-    g[k + 1] = -sn[k] * g[k];
-    g[k] = cs[k] * g[k];
-    if (std::abs(g[k + 1]) <= 0.1 * solver_.krylov_tolerance * beta || hn == 0.0) {
-      ++k;
-      break;
-    }
-  }
-  iterations = k;
-  const Eigen::VectorXd y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
-  d.noalias() = Z.leftCols(k) * y;
-  // The true residual decides (round-off in the recurrence, a stagnating Krylov space).
-  if (!d.allFinite()) return false;
-  op(d, w);
-  return (w - b).norm() <= solver_.krylov_tolerance * beta;
-}
-
 bool ReducedEquations::solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) {
   // Only below krylov_min_size unknowns (or with the dense solver): larger systems are
   // matrix-free and go through solve_bordered().
@@ -377,30 +319,19 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     y.head(n) = jz.cwiseQuotient(A.r_scale) + A.column * z[n];
     y[n] = A.row.dot(z);
   };
-  // The preconditioner in single precision: half the memory traffic of the triangular
-  // solves and twice the vector width of the factorization; GMRES and its true-residual
-  // check stay in double, so only the iteration count can suffer.
-  auto precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& z) {
-    z = luf_.solve(v.cast<float>()).cast<double>();
-  };
+  // The lagged preconditioner, single precision (linalg/lagged_lu.hpp).
+  auto precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& z) { preconditioner_.apply(v, z); };
+  const linalg::GmresOptions gmres_options{solver_.krylov_max_iterations, solver_.krylov_tolerance};
   bool ok = false;
-  if (luf_valid_ && !refactor_ && luf_.rows() == n + 1) {
-    int iterations = 0;
-    ok = gmres(op, precondition, b, d, iterations);
-    krylov_iterations_since_factor_ += iterations;
-    stats_.krylov_iterations += iterations;
+  if (preconditioner_.usable(n + 1)) {
+    const linalg::GmresResult g = linalg::gmres(op, precondition, b, d, gmres_options);
+    ok = g.converged;
+    preconditioner_.add_iterations(g.iterations);
+    stats_.krylov_iterations += g.iterations;
     if (ok) {
       ++stats_.krylov_solves;
-      // Renew the factors when the lagged ones have become poor (many iterations) and the
-      // iterations since the last factorization have cost more than it did. The costs are
-      // counted, not timed, so that the path is the same on every run and machine: a
-      // factorization is (2/3) m^3 flops (m = n + 1) at BLAS-3 speed, an iteration is
-      // dominated by its two triangular solves, 2 m^2 flops at BLAS-2 speed, about
-      // kTriangularSlowdown times slower per flop: a factorization is worth m / 12 iterations.
-      constexpr double kTriangularSlowdown = 4.0;
-      const double m = static_cast<double>(n + 1);
-      refactor_ = iterations > solver_.refactor_after &&
-                  kTriangularSlowdown * 2.0 * m * m * krylov_iterations_since_factor_ > (2.0 / 3.0) * m * m * m;
+      // Renew the factors when the lagged ones have become poor (the rule of lagged_lu.hpp).
+      preconditioner_.decide_renewal(g.iterations, solver_.refactor_after);
     } else {
       ++stats_.krylov_failures;
     }
@@ -413,17 +344,14 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     Ad.topLeftCorner(n, n).noalias() = A.r_scale.cwiseInverse().asDiagonal() * J * A.x_scale.asDiagonal();
     Ad.col(n).head(n) = A.column;
     Ad.row(n) = A.row.transpose();
-    luf_.compute(Ad.cast<float>());
-    krylov_iterations_since_factor_ = 0;
+    preconditioner_.factorize(Ad);
     ++stats_.dense_factorizations;
-    luf_valid_ = true;
-    refactor_ = false;
     // With the factors of this very matrix GMRES needs a few iterations (single precision
     // against double); if even that fails (A too ill-conditioned for single precision), a
     // direct solve in double answers.
-    int iterations = 0;
-    ok = gmres(op, precondition, b, d, iterations);
-    stats_.krylov_iterations += iterations;
+    const linalg::GmresResult g = linalg::gmres(op, precondition, b, d, gmres_options);
+    ok = g.converged;
+    stats_.krylov_iterations += g.iterations;
     if (ok) {
       ++stats_.krylov_solves;
     } else {
@@ -475,66 +403,6 @@ Eigen::VectorXd ReducedEquations::stuck_solution(double frequency_hz) const {
     add_harmonic(Eigen::PartialPivLU<Eigen::MatrixXcd>(a).solve(rhs), n, w);
   }
   return w;
-}
-
-namespace {
-
-/// r(W, s) = W - s W_lin + G F(W) at a fixed frequency: lambda is the excitation scale.
-class ExcitationHomotopy : public continuation::ParametricResidual {
- public:
-  ExcitationHomotopy(ReducedEquations& eq, double frequency_hz) : eq_(eq), frequency_hz_(frequency_hz) {}
-  int size() const override { return eq_.size(); }
-  bool has_lambda_derivative() const override { return true; }
-  bool evaluate(const Eigen::VectorXd& w, double s, Eigen::VectorXd& r, Eigen::MatrixXd* J,
-                Eigen::VectorXd* dl) override {
-    eq_.set_excitation_scale(s);
-    const bool ok = eq_.evaluate(w, frequency_hz_, r, J, nullptr);
-    if (dl) *dl = -lin_;
-    return ok;
-  }
-  bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override {
-    return eq_.solve_augmented(A, b, d);
-  }
-  // dR/dW is the equations' own J: their matrix-free solves serve the homotopy too.
-  bool matrix_free() const override { return eq_.matrix_free(); }
-  bool linearize(const Eigen::VectorXd& w, double s, Eigen::VectorXd& r, Eigen::VectorXd* dl) override {
-    eq_.set_excitation_scale(s);
-    const bool ok = eq_.linearize(w, frequency_hz_, r, nullptr);
-    if (dl) *dl = -lin_;
-    return ok;
-  }
-  bool solve_bordered(const continuation::BorderedMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override {
-    return eq_.solve_bordered(A, b, d);
-  }
-  Eigen::VectorXd lin_;
-
- private:
-  ReducedEquations& eq_;
-  double frequency_hz_;
-};
-
-}  // namespace
-
-continuation::Branch ReducedEquations::solve_by_excitation_homotopy(double frequency_hz,
-                                                                    const continuation::ArclengthOptions& options,
-                                                                    Eigen::VectorXd& w) {
-  ExcitationHomotopy homotopy(*this, frequency_hz);
-  homotopy.lin_ = linear_motion(frequency_hz);
-  continuation::ArclengthOptions o = options;
-  o.lambda_start = 0.0;
-  o.lambda_end = 1.0;
-  o.lambda_scale = 1.0;
-  o.initial_step = 0.05;
-  o.max_step = 4.0;
-  o.max_points = std::min(o.max_points, 2000);  // a start that needs more is not worth waiting for
-  o.start_slack = 1.0;  // the path may fold back through s < 0 (the excitation reversed)
-  const double saved = excitation_scale_;
-  excitation_scale_ = 0.0;
-  const Eigen::VectorXd start = stuck_solution(frequency_hz);
-  continuation::Branch b = continuation::trace(homotopy, start, o);
-  excitation_scale_ = saved;
-  if (b.status == continuation::BranchStatus::kReachedEnd) w = b.points.back().x;
-  return b;
 }
 
 PointResult ReducedEquations::analyse(const Eigen::VectorXd& w, double frequency_hz, int time_points) {

@@ -18,27 +18,26 @@
 // iteration and continuation step to the next. Below `krylov_min_size` unknowns the
 // continuation receives the dense J and the augmented system is solved by a dense LU
 // (solve_augmented). From krylov_min_size on the residual is matrix-free for the
-// continuation (linearize, solve_bordered): the bordered system is solved by GMRES whose
-// products use the factors of the linearization, (I + G D) z = z + G (D z) per pair and per
-// harmonic (O(n b + c^2 H) instead of the O(n^2) of a dense product), right-preconditioned by
-// the single-precision LU factors of the dense bordered matrix of an earlier linearization.
-// J is formed densely only to renew those factors (when GMRES failed, or needed many
-// iterations that have cost more flops than a factorization; counted, not timed, so the path
-// is reproducible), never per evaluation, so the
-// worst case is one dense LU per solve. The solution is checked by its true residual,
-// ||A d - b|| <= krylov_tolerance ||b||, in double precision.
+// continuation (linearize, solve_bordered): the bordered system is solved by GMRES
+// (linalg/gmres.hpp) whose products use the factors of the linearization,
+// (I + G D) z = z + G (D z) per pair and per harmonic (O(n b + c^2 H) instead of the O(n^2)
+// of a dense product), right-preconditioned by the single-precision LU factors of the dense
+// bordered matrix of an earlier linearization (linalg/lagged_lu.hpp). J is formed densely
+// only to renew those factors (when GMRES failed, or the preconditioner's counted renewal
+// rule says so), never per evaluation, so the worst case is one dense LU per solve. The
+// solution is checked by its true residual, ||A d - b|| <= krylov_tolerance ||b||, in
+// double precision.
 //
 // The residual also gives dr/df (f the frequency in Hz) from the linear part's exact
 // frequency derivative (no extra contact evaluations), and repeats of an evaluation at the
 // same (W, f) (the continuation evaluates the converged point twice) are served from a copy.
 #include <Eigen/Core>
-#include <Eigen/LU>
-#include <functional>
 #include <vector>
 
 #include "continuation/arclength.hpp"
 #include "frf/linear_part.hpp"
 #include "hbm/contact_evaluator.hpp"
+#include "linalg/lagged_lu.hpp"
 
 namespace shroudsim::forced {
 
@@ -107,7 +106,7 @@ class ReducedEquations : public continuation::ParametricResidual {
 
   void set_linear_solver(const LinearSolverOptions& options) {
     solver_ = options;
-    luf_valid_ = false;
+    preconditioner_.invalidate();
   }
   const LinearSolverOptions& linear_solver() const { return solver_; }
   const SolverStatistics& statistics() const { return stats_; }
@@ -126,16 +125,11 @@ class ReducedEquations : public continuation::ParametricResidual {
   /// the preload): a good start for Newton.
   Eigen::VectorXd stuck_solution(double frequency_hz) const;
 
-  /// Scales the excitation: r = W - s W_lin + G F(W) (s = 1 is the case itself).
+  /// Scales the excitation: r = W - s W_lin + G F(W) (s = 1 is the case itself; the
+  /// continuation in s is forced/excitation_homotopy.hpp).
   void set_excitation_scale(double s) { excitation_scale_ = s; }
   double excitation_scale() const { return excitation_scale_; }
 
-  /// A solution at `frequency_hz` found by continuation in the excitation scale s from 0
-  /// (preload only: the stuck solution is exact when the preload alone does not slip) to 1.
-  /// Robust where Newton from a guess cycles between contact states. Returns the branch's
-  /// status; on success w holds the solution at s = 1.
-  continuation::Branch solve_by_excitation_homotopy(double frequency_hz, const continuation::ArclengthOptions& options,
-                                                    Eigen::VectorXd& w);
   /// Response, harmonics and energy balance at a solution point.
   PointResult analyse(const Eigen::VectorXd& w, double frequency_hz, int time_points = 512);
 
@@ -162,11 +156,6 @@ class ReducedEquations : public continuation::ParametricResidual {
   void add_harmonic(const Eigen::VectorXcd& z, int n, Eigen::VectorXd& out) const;
   /// out = sum_n M_n v_n (M = g or dg of h): a block-diagonal-over-harmonics product.
   void apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
-  /// GMRES on A d = b with the product `op` (the action of A) and the preconditioner M^-1.
-  /// The solution is accepted if its true residual with `op` is below krylov_tolerance.
-  bool gmres(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& op,
-             const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& precondition, const Eigen::VectorXd& b,
-             Eigen::VectorXd& d, int& iterations) const;
   bool evaluate_impl(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r, Eigen::MatrixXd* J,
                      Eigen::VectorXd* dr_dlambda, bool linearize);
   /// y = (I + G D) z with the G_n and D_p of the last Jacobian evaluation: O(n b + c^2 H).
@@ -192,10 +181,8 @@ class ReducedEquations : public continuation::ParametricResidual {
   std::vector<Eigen::MatrixXcd> jac_g_;
   std::vector<Eigen::MatrixXd> jac_blocks_;
   bool jac_valid_ = false;
-  // Lagged preconditioner: LU factors of an earlier augmented matrix.
-  Eigen::PartialPivLU<Eigen::MatrixXf> luf_;  // single precision
-  bool luf_valid_ = false, refactor_ = false;
-  long krylov_iterations_since_factor_ = 0;   // GMRES iterations since the last factorization
+  // Lagged preconditioner: single-precision LU factors of an earlier bordered matrix.
+  linalg::LaggedLuPreconditioner preconditioner_;
 };
 
 }  // namespace shroudsim::forced

@@ -25,7 +25,7 @@
 #include <string_view>
 #include <vector>
 
-#include "contact/contact_law.hpp"
+#include "contact/periodic_law.hpp"
 #include "hbm/aft.hpp"
 #include "hbm/harmonic_layout.hpp"
 

@@ -1,34 +1,31 @@
 #pragma once
 // Lowest modes of K phi = w^2 M phi (real symmetric, or complex Hermitian from the cyclic
-// reduction) by Spectra's Lanczos (SymEigsSolver, implicit restarts) on the symmetric
-// shift-invert operator  L^{-1} P M P^T L^{-H},  P (K - sigma M) P^T = L L^H  (CHOLMOD,
-// supernodal). Its eigenvalues are nu = 1 / (w^2 - sigma), its eigenvectors y = L^H P phi;
-// Lanczos then needs the Euclidean inner product only: one solve and one product with M
-// per step (Spectra 1.0.1's SymGEigsShiftSolver, with M-inner products, applies M about
-// eight times per step).
+// reduction, docs/physics.md section 1): the driver that checks the problem, picks a method,
+// and checks every mode before returning it.
 //
-// Complex Hermitian problems are solved through the real symmetric 2n embedding
-//   H = A + i B  ->  [A  -B]        z = a + i b  ->  [a; b],
-//                    [B   A],
-// applied with complex CHOLMOD half solves (cheaper than factoring the 2n real matrix).
-// Every physical mode z appears twice there ([a; b] and the embedding of i z, [-b; a]);
-// Spectra is asked for 2 * modes + 4 eigenvalues, the Ritz vectors are mapped back to
-// complex vectors, grouped by eigenvalue, and each group's complex span is reduced to its
-// physical modes (M-orthonormalised, Rayleigh-Ritz when a group holds more than one
-// physical mode). Each mode is returned once.
-//
-// The default method for large problems is a block Krylov-Schur iteration (thick-restarted
-// block Lanczos with full reorthogonalization) on the same operator, in the problem's own
-// scalar type: complex Hermitian problems need no 2n embedding and no doubled eigenvalues,
-// and the operator is applied to blocks of `block_size` vectors (CHOLMOD's supernodal
-// solve runs BLAS-3 kernels on a block; single-vector solves are memory bound). At 2e5
-// DOFs, complex, it needs a third of the solve time of Spectra's Lanczos on the embedding
-// (92 vectors against 130, each cheaper). Spectra stays selectable (ModalOptions::method)
-// and the tests compare the two.
+// The sparse methods work on the symmetric shift-invert operator
+// C = L^{-1} P M P^T L^{-H},  P (K - sigma M) P^T = L L^H  (modal/shift_invert.hpp): its
+// eigenvalues nu = 1 / (w^2 - sigma) are largest for the lowest modes, and an eigenvector y
+// gives the mass-normalised mode phi = P^T L^{-H} y / sqrt(nu).
+//  - Block (the default): block Krylov-Schur on C in the problem's own scalar type
+//    (modal/block_krylov_schur.hpp), blocks of `block_size` vectors per application of C.
+//    Complex Hermitian problems need no 2n embedding and no doubled eigenvalues.
+//  - Spectra: Spectra's SymEigsSolver (implicitly restarted Lanczos) on C. Complex Hermitian
+//    problems are solved through the real symmetric 2n embedding
+//      H = A + i B  ->  [A  -B]        z = a + i b  ->  [a; b],
+//                       [B   A],
+//    applied with complex CHOLMOD half solves (cheaper than factoring the 2n real matrix).
+//    Every physical mode z appears twice there ([a; b] and the embedding of i z, [-b; a]):
+//    Spectra is asked for 2 * modes + 4 eigenvalues, the Ritz vectors are mapped back to
+//    complex vectors, grouped by eigenvalue, and each group's complex span is reduced to its
+//    physical modes (M-orthonormalised, Rayleigh-Ritz when a group holds more than one
+//    physical mode). Each mode is returned once. Kept selectable; the tests compare the two.
+//  - Dense (Eigen's generalized solver) for n <= 300, or when the method's basis would not
+//    fit in n.
 //
 // Every returned mode is checked: ||K phi - w^2 M phi|| <= residual_tolerance * ||K phi||.
-// Failure (factorization, Spectra not converging, residual too large, too few modes) is
-// reported in ModalReport (status + message), never by silently returning modes.
+// Failure (factorization, no convergence, residual too large, too few modes) is reported
+// in ModalReport (status + message), never by silently returning modes.
 //
 // Units: K in N/m, M in kg, omega in rad/s, shift in (rad/s)^2.
 #include <Eigen/Core>
@@ -38,6 +35,8 @@
 
 #include "linalg/cholmod_factor.hpp"
 #include "linalg/sparse.hpp"
+#include "modal/shift_invert.hpp"
+#include "modal/stiffness_factor.hpp"
 
 namespace shroudsim::modal {
 
@@ -101,32 +100,6 @@ struct ModalReport {
   bool ok() const { return status == ModalStatus::Converged; }
 };
 
-/// A kept factorization of K (real or complex Hermitian) for static solves K x = b with
-/// complex right-hand sides; `conjugated` solves with conj(K) (harmonic index Nb - h).
-class StiffnessFactor {
- public:
-  StiffnessFactor() = default;
-  explicit StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>> real);
-  StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>> complex, bool conjugated);
-  bool valid() const { return real_ || complex_; }
-  Eigen::Index rows() const;
-  /// x = K^{-1} b (columns).
-  Eigen::MatrixXcd solve(const Eigen::MatrixXcd& b) const;
-  /// The factor of conj(K) (for Nb - h), sharing the same CHOLMOD factor.
-  StiffnessFactor conjugate() const;
-
- private:
-  std::shared_ptr<const linalg::CholmodFactor<double>> real_;
-  std::shared_ptr<const linalg::CholmodFactor<Complex>> complex_;
-  bool conjugated_ = false;
-};
-
-/// Factorizes K (throws NumericalError if it is not positive definite).
-StiffnessFactor factor_stiffness(const linalg::SparseMatrixD& K,
-                                 linalg::FactorMethod method = linalg::FactorMethod::Supernodal);
-StiffnessFactor factor_stiffness(const linalg::SparseMatrixC& K,
-                                 linalg::FactorMethod method = linalg::FactorMethod::Supernodal);
-
 struct ModalResult {
   ModalBasis basis;           ///< the converged modes (empty unless report.ok())
   ModalReport report;
@@ -135,23 +108,10 @@ struct ModalResult {
 
 /// Lowest options.modes modes of a real symmetric pair (basis.phi is real-valued).
 ModalResult solve_modes(const linalg::SparsePair<double>& km, int harmonic_index, const ModalOptions& options);
-/// Lowest options.modes modes of a complex Hermitian pair (real 2n embedding).
+/// Lowest options.modes modes of a complex Hermitian pair (Spectra: through the real 2n embedding).
 ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int harmonic_index, const ModalOptions& options);
 
-/// A CHOLMOD symbolic analysis kept across solves of matrices with one sparsity pattern
-/// (a speed sweep K + Omega^2 D: the same pattern at every speed). The first solve given a
-/// FactorReuse analyzes and factorizes; later ones of the same size only refactorize
-/// numerically (a matrix of another size or number of stored entries is analyzed afresh;
-/// the caller guarantees that equal counts mean an equal pattern). Not thread-safe: one per
-/// worker. Solves given a FactorReuse return no StiffnessFactor (the factor is overwritten
-/// by the next solve).
-struct FactorReuse {
-  std::shared_ptr<linalg::CholmodFactor<double>> real;
-  std::shared_ptr<linalg::CholmodFactor<Complex>> complex;
-  Eigen::Index real_nonzeros = -1, complex_nonzeros = -1;  ///< stored entries of the analyzed patterns
-  int analyses = 0;           ///< symbolic analyses done through this object
-  int factorizations = 0;     ///< numeric factorizations done through this object
-};
+/// The same, reusing `reuse`'s symbolic analysis (FactorReuse, modal/shift_invert.hpp).
 ModalResult solve_modes(const linalg::SparsePair<double>& km, int harmonic_index, const ModalOptions& options,
                         FactorReuse& reuse);
 ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int harmonic_index, const ModalOptions& options,

@@ -7,7 +7,8 @@
 #include <numbers>
 #include <random>
 
-#include "contact/contact_law.hpp"
+#include "contact/friction_step.hpp"
+#include "contact/periodic_law.hpp"
 
 namespace {
 

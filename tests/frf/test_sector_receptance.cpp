@@ -127,6 +127,7 @@ TEST(SectorReceptance, ModalSumWithResidualFlexibilityMatchesTheDirectSolve) {
 }  // namespace
 }  // namespace shroudsim::frf
 
+#include "forced/excitation_homotopy.hpp"
 #include "forced/reduced_equations.hpp"
 
 namespace shroudsim::frf {
@@ -172,7 +173,7 @@ TEST(SectorForced, EnergyBalanceAndOpenGapOnTheSector) {
     ao.x_scale = Eigen::VectorXd::Constant(eq.size(), 1e-6);
     ao.tolerance = 1e-9;
     Eigen::VectorXd w;
-    const auto b = eq.solve_by_excitation_homotopy(f_hz, ao, w);
+    const auto b = forced::solve_by_excitation_homotopy(eq, f_hz, ao, w);
     ASSERT_EQ(b.status, continuation::BranchStatus::kReachedEnd) << model << ": " << b.message;
     const forced::PointResult r = eq.analyse(w, f_hz);
     // Excitation work = modal viscous + contact dissipation, to the Newton tolerance.

@@ -1,0 +1,422 @@
+#include "contact/periodic_law.hpp"
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "contact/friction_step.hpp"
+#include "core/error.hpp"
+
+namespace shroudsim::contact {
+
+PeriodicLaw::PeriodicLaw(LawOptions options) : options_(options) {
+  std::vector<std::string> errors;
+  if (!options_.validate(&errors)) throw std::invalid_argument("contact::LawOptions: " + errors[0]);
+  if (options_.model == Model::one_d_exact)
+    throw std::invalid_argument(
+        "contact::PeriodicLaw: model 1d_exact is time-continuous (use jenkins_single_harmonic)");
+}
+
+PeriodicStatus PeriodicLaw::evaluate(const PairParameters& pair, const Eigen::MatrixX3d& w,
+                                     Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
+                                     LinearizedPeriod* lin) {
+  SHROUDSIM_CHECK((basis == nullptr) == (lin == nullptr), "basis and lin go together");
+  SHROUDSIM_CHECK(w.rows() >= 1, "at least one sample");
+  if (basis != nullptr) {
+    SHROUDSIM_CHECK(basis->rows() == w.rows(), "basis rows = time samples");
+    return run<true>(pair, w, f, basis, lin);
+  }
+  return run<false>(pair, w, f, nullptr, nullptr);
+}
+
+namespace {
+// Pseudo-inverse of A = I - Phi_d (2 x 2). Phi_d is a product of per-sample maps: 0 at
+// separation, a contraction at slip, the identity in stick, and exactly neutral directions
+// (eigenvalue 1: a family of periodic states, e.g. a static tangential load at the slip
+// limit, or pure stick) appear as singular values of A at the round-off of that product
+// (~1e-13 for a few hundred samples). Those directions are dropped (d* held along them, as
+// d = 0 is kept in pure stick); kSingular sits well above that round-off and far below any
+// contraction the iteration resolves (1 - lambda = 1e-10 would need ~1e11 plain periods).
+constexpr double kSingular = 1e-10;
+// Plain periods before the Newton iteration of the coupled model starts (see run()).
+constexpr int kPlainPeriods = 4;
+bool pseudo_inverse2(const Eigen::Matrix2d& a, Eigen::Matrix2d& inv) {
+  if (!a.allFinite()) return false;
+  const Eigen::JacobiSVD<Eigen::Matrix2d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector2d sv = svd.singularValues();
+  Eigen::Vector2d si = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 2; ++i)
+    if (sv(i) > kSingular) si(i) = 1.0 / sv(i);
+  if (si.isZero(0.0)) return false;
+  inv = svd.matrixV() * si.asDiagonal() * svd.matrixU().transpose();
+  return inv.allFinite();
+}
+}  // namespace
+
+template <bool kD>
+PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX3d& w,
+                                Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
+                                LinearizedPeriod* lin) {
+  const int n = static_cast<int>(w.rows());
+  const Model model = options_.model;
+  const bool two_d = model != Model::one_d;
+  const bool has_normal = model != Model::one_d;
+  const bool coupled = model == Model::full3d;
+
+  const int m = kD ? static_cast<int>(basis->cols()) : 0;
+  const int p = n_directions(model) * m;
+
+  double wmax = 0.0;
+  for (int l = 0; l < n; ++l) {
+    wmax = std::max(wmax, std::abs(w(l, 0)));
+    if (two_d) wmax = std::max(wmax, std::abs(w(l, 1)));
+  }
+  const double tol = options_.period_tolerance * wmax;
+
+  f.setZero(n, 3);
+  if constexpr (kD) {
+    xd_.setZero(p);
+    yd_.setZero(p);
+    lin->prepare(n, p, two_d ? 2 : 1, pair.tangential_stiffness, has_normal ? pair.normal_stiffness : 0.0);
+  }
+  d_ = {0.0, 0.0};  // damper position [m], starts at 0
+  anchor_ = {};
+  PeriodicStatus status;
+  status.converged = false;
+  auto change = [](const std::array<double, 2>& a, const std::array<double, 2>& b) {
+    return std::max(std::abs(a[0] - b[0]), std::abs(a[1] - b[1]));
+  };
+
+  if (!coupled) {
+    // Uncoupled models: plain repetition (memoryless slip: 2 periods typically), the
+    // derivative carried through all periods by the anchors.
+    for (int k = 1; k <= options_.max_periods; ++k) {
+      const std::array<double, 2> d_start = d_;
+      period<kD>(pair, w, f, basis, lin, false);
+      status.periods = k;
+      if (change(d_, d_start) <= tol) {
+        status.converged = true;
+        break;
+      }
+    }
+    return status;
+  }
+
+  // Coupled model. First plain repetition from d = 0 for up to kPlainPeriods periods (with
+  // the derivative carried through them, as for the uncoupled models): most states repeat
+  // within 2 to 4 periods, at the cost they had before.
+  for (int k = 1; k <= std::min(kPlainPeriods, options_.max_periods); ++k) {
+    const std::array<double, 2> d_start = d_;
+    last_start_ = d_start;
+    period<kD>(pair, w, f, basis, lin, false);
+    status.periods = k;
+    if (change(d_, d_start) <= tol) {
+      status.converged = true;
+      return status;
+    }
+  }
+  // Slow repetition (a weak contraction, e.g. a static tangential load at the slip limit with
+  // a small oscillation: ~0.998 per period): safeguarded Newton on g(d) = Phi(d) - d from where
+  // the plain periods ended, forces-only periods carrying Phi_d. A Newton step is accepted
+  // when it reduces max|g| (Phi is strongly curved far from d*: the first steps reduce |g| by
+  // ~2, the last ones quadratically), else the plain repetition d <- Phi(d) is taken.
+  std::array<double, 2> dk{0.0, 0.0};  // accepted iterate
+  auto pass = [&](const std::array<double, 2>& start) {
+    d_ = start;
+    period<false>(pair, w, f, nullptr, nullptr, true);
+    ++status.periods;
+    return std::array<double, 2>{d_[0] - start[0], d_[1] - start[1]};  // g(start)
+  };
+  // From where the plain periods ended (unless the cap is reached already).
+  dk = d_;
+  std::array<double, 2> g{};
+  double gn = 0.0;
+  Eigen::Matrix2d jk = Eigen::Matrix2d::Identity();
+  bool slipped = false;
+  if (status.periods < options_.max_periods) {
+    g = pass(dk);
+    gn = std::max(std::abs(g[0]), std::abs(g[1]));
+    jk = dd_start_;
+    slipped = slipped_;
+  } else {
+    gn = change(d_, last_start_);
+    dk = last_start_;
+  }
+  while (!(gn <= tol) && status.periods < options_.max_periods) {
+    if (slipped) {
+      // Newton: g(dk + delta) ~ g + (Phi_d - I) delta = 0.
+      Eigen::Matrix2d ai;
+      if (pseudo_inverse2(Eigen::Matrix2d::Identity() - jk, ai)) {
+        const Eigen::Vector2d delta = ai * Eigen::Vector2d(g[0], g[1]);
+        const std::array<double, 2> trial{dk[0] + delta.x(), dk[1] + delta.y()};
+        if (std::isfinite(trial[0]) && std::isfinite(trial[1]) && (delta.x() != 0.0 || delta.y() != 0.0)) {
+          const std::array<double, 2> gt = pass(trial);
+          const double gtn = std::max(std::abs(gt[0]), std::abs(gt[1]));
+          if (gtn <= tol || gtn < gn) {  // accepted
+            dk = trial;
+            g = gt;
+            gn = gtn;
+            jk = dd_start_;
+            slipped = slipped_;
+            continue;
+          }
+          if (status.periods >= options_.max_periods) break;
+        }
+      }
+    }
+    // Safeguard: plain repetition, dk <- Phi(dk) = dk + g.
+    dk = {dk[0] + g[0], dk[1] + g[1]};
+    g = pass(dk);
+    gn = std::max(std::abs(g[0]), std::abs(g[1]));
+    jk = dd_start_;
+    slipped = slipped_;
+  }
+  status.converged = gn <= tol;
+  if constexpr (kD) {
+    // The returned period once more from dk with the derivative, at fixed d_start
+    // (xd_ = yd_ = 0), carrying the sensitivities to d_start; then add the term through
+    // dd*/dc = (I - Phi_d)^{-1} Phi_c.
+    d_ = dk;
+    xd_.setZero();
+    yd_.setZero();
+    period<true>(pair, w, f, basis, lin, true);
+    Eigen::Matrix2d ai;
+    fixed_point_dc_.resize(2, p);
+    if (slipped_ && pseudo_inverse2(Eigen::Matrix2d::Identity() - dd_start_, ai)) {
+      fixed_point_dc_.row(0) = ai(0, 0) * xd_ + ai(0, 1) * yd_;
+      fixed_point_dc_.row(1) = ai(1, 0) * xd_ + ai(1, 1) * yd_;
+    } else {
+      fixed_point_dc_.setZero();  // pure stick: d* held (see the header)
+    }
+    if (!fixed_point_dc_.isZero(0.0)) add_fixed_point_term(*lin, fixed_point_dc_, run_d_, dense_q_);
+  }
+  return status;
+}
+
+struct PeriodicLaw::Sample {
+  int l = 0, lp = 0;            // the sample and the one before it (l - 1, cyclically)
+  double wx = 0.0, wy = 0.0;    // w_t(l) [m] (wy = 0 for the 1d model)
+  double wpx = 0.0, wpy = 0.0;  // w_t(lp) [m]
+  double lim = 0.0;             // mu N(l) [N]
+  double nprev = 0.0;           // N(lp) [N], for exact_linear
+  bool pressed_prev = false;    // N0 + kn z(lp) > 0
+};
+
+// The updates of one sample, forced inline into period()'s sample loop: a call per sample is
+// a large part of the cost of a forces-only evaluation.
+
+template <bool kD>
+[[gnu::always_inline]] inline
+void PeriodicLaw::separate(const Sample& s, const Eigen::MatrixXd* basis, PeriodRecorder* rec, bool track) {
+  d_ = {s.wx, s.wy};
+  if constexpr (kD) {
+    rec->release(0);
+    rec->release(1);
+  }
+  anchor_[0] = {s.l, 1.0, 0.0};
+  anchor_[1] = {s.l, 1.0, 0.0};
+  if (track) {
+    dd_start_.setZero();
+    slipped_ = true;
+  }
+  if constexpr (kD) {
+    const int m = static_cast<int>(basis->cols());
+    xd_.setZero();
+    xd_.segment(0, m) = basis->row(s.l);
+    if (options_.model != Model::one_d) {
+      yd_.setZero();
+      yd_.segment(m, m) = basis->row(s.l);
+    }
+  }
+}
+
+template <bool kD>
+[[gnu::always_inline]] inline
+void PeriodicLaw::record_coupled_stick(int l, PeriodRecorder* rec, bool track) {
+  // dT = kt (dw_t - dd), dd unchanged: the runs' damper derivative is the current one.
+  if constexpr (kD) {
+    if (rec->stick(0, l, xd_) && track) run_d_[0].push_back(dd_start_);
+    if (rec->stick(1, l, yd_) && track) run_d_[1].push_back(dd_start_);
+  }
+}
+
+template <bool kD>
+[[gnu::always_inline]] inline
+void PeriodicLaw::track_coupled_slip(const Eigen::Matrix2d& md, double kt) {
+  if constexpr (kD) dense_q_.push_back(-kt * md);
+  dd_start_ = md;
+  slipped_ = true;
+}
+
+template <bool kD>
+[[gnu::always_inline]] inline
+std::array<double, 2> PeriodicLaw::coupled_radial_return(const PairParameters& pair, const Sample& s,
+                                                         const Eigen::MatrixXd* basis, PeriodRecorder* rec,
+                                                         bool track) {
+  const double kt = pair.tangential_stiffness;
+  const RadialReturn r = radial_return(s.wx, s.wy, d_, kt, s.lim);
+  if (r.stick) {
+    record_coupled_stick<kD>(s.l, rec, track);
+    return {r.tx, r.ty};
+  }
+  if (track) {
+    // d(d_start) only: dT* = -kt D, dT = rho (I - e e^T) dT*, D <- -dT/kt.
+    Eigen::Matrix2d proj;
+    proj << 1.0 - r.ex * r.ex, -r.ex * r.ey, -r.ex * r.ey, 1.0 - r.ey * r.ey;
+    const Eigen::Matrix2d md = r.rho * proj * dd_start_;
+    track_coupled_slip<kD>(md, kt);
+  }
+  if constexpr (kD)
+    rec->radial_return_slip(*basis, s.l, kt, pair.normal_stiffness, pair.friction_coefficient, r.ex, r.ey, r.rho, xd_,
+                            yd_);
+  return {r.tx, r.ty};
+}
+
+template <bool kD>
+[[gnu::always_inline]] inline
+std::array<double, 2> PeriodicLaw::coupled_exact_linear(const PairParameters& pair, const Sample& s,
+                                                        const Eigen::MatrixXd* basis, PeriodRecorder* rec,
+                                                        bool track) {
+  // Elastic displacement e = w_t - d integrated over the step, slip radius linear within the
+  // step, from mu N(l-1)/kt to mu N(l)/kt.
+  const double kt = pair.tangential_stiffness;
+  const double mu = pair.friction_coefficient;
+  const Eigen::Vector2d e0(s.wpx - d_[0], s.wpy - d_[1]);
+  const Eigen::Vector2d dw(s.wx - s.wpx, s.wy - s.wpy);
+  const double a_end = s.lim / kt;
+  const double a = mu * s.nprev / kt;
+  Eigen::Matrix<double, 2, 6> jl;
+  bool stuck = false;
+  Eigen::Vector2d e1 = exact_linear_step(e0, dw, a, a_end, kD ? &jl : nullptr, &stuck);
+  // Forces-only tracking: the step's Jacobian only where it does not simply stick.
+  if (!kD && track && !stuck) e1 = exact_linear_step(e0, dw, a, a_end, &jl, &stuck);
+  d_ = {s.wx - e1.x(), s.wy - e1.y()};
+  if (stuck) {  // e1 = e0 + dw
+    record_coupled_stick<kD>(s.l, rec, track);
+  } else {
+    if (track) {
+      // d(d_start) only: de1 = J_e0 (-D), dT = kt de1, D <- -de1.
+      const Eigen::Matrix2d md = jl.leftCols<2>() * dd_start_;
+      track_coupled_slip<kD>(md, kt);
+    }
+    if constexpr (kD)
+      rec->exact_linear_slip(*basis, s.l, s.lp, kt, pair.normal_stiffness, mu, s.pressed_prev, jl, xd_, yd_);
+  }
+  return {kt * e1.x(), kt * e1.y()};
+}
+
+template <bool kD>
+[[gnu::always_inline]] inline
+std::array<double, 2> PeriodicLaw::uncoupled(const PairParameters& pair, const Sample& s, PeriodRecorder* rec) {
+  // quasi3d (x and y) or 1d (x): independent 1D laws with limit mu N(l). Their slip is
+  // memoryless, so the damper derivative is always X_i = alpha E_i(s) + beta E_z(s) for
+  // the last slip or separation sample s (an "anchor"; 0 before any): no P-wide rows.
+  const bool two_d = options_.model != Model::one_d;
+  const bool has_normal = options_.model != Model::one_d;
+  const bool exact = options_.update == TangentialUpdate::exact_linear;
+  const double kt = pair.tangential_stiffness;
+  const double kn = pair.normal_stiffness;
+  const double mu = pair.friction_coefficient;
+  const int ndir = two_d ? 2 : 1;
+  const double ca = has_normal ? mu * kn / kt : 0.0;
+  std::array<double, 2> t{0.0, 0.0};
+  for (int i = 0; i < ndir; ++i) {
+    const double wi = (i == 0) ? s.wx : s.wy;
+    AxisStep step;
+    if (!exact) {
+      step = axis_radial_return(wi, d_[i], kt, s.lim);
+    } else {
+      const double a_end = s.lim / kt;
+      const double a = mu * s.nprev / kt;
+      step = axis_exact_linear(wi, (i == 0) ? s.wpx : s.wpy, d_[i], kt, a, a_end);
+    }
+    if (step.slip != 0.0) {
+      // Slipping at the sample: dT_i = sg mu kn E_z(l); X_i = E_i(l) - dT_i/kt.
+      if constexpr (kD) rec->slip(i, s.l, kt * ca * step.slip);
+      anchor_[i] = {s.l, 1.0, -ca * step.slip};
+    } else {
+      if (step.start != 0.0) {
+        // exact_linear, start clamped: e1 = a0 sg + w(l) - w(lp), the damper was reset at lp
+        // (X_i = E_i(lp) - c_a mu kn E_z(lp)/kt), then the step sticks.
+        const double c_a = s.pressed_prev ? step.start : 0.0;
+        anchor_[i] = {s.lp, 1.0, -c_a * ca};
+      }
+      if constexpr (kD) rec->stick_anchored(i, s.l, anchor_[i].s, anchor_[i].alpha, anchor_[i].beta);
+    }
+    t[static_cast<std::size_t>(i)] = step.t;
+  }
+  return t;
+}
+
+template <bool kD>
+void PeriodicLaw::period(const PairParameters& pair, const Eigen::MatrixX3d& w,
+                         Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
+                         LinearizedPeriod* lin, bool track) {
+  const int n = static_cast<int>(w.rows());
+  const Model model = options_.model;
+  const bool two_d = model != Model::one_d;
+  const bool has_normal = model != Model::one_d;
+  const bool coupled = model == Model::full3d;
+  const bool exact = options_.update == TangentialUpdate::exact_linear;
+  const double kn = pair.normal_stiffness;
+  const double mu = pair.friction_coefficient;
+  const double n0 = pair.normal_preload;
+  if (track) {
+    dd_start_.setIdentity();  // d(d)/d(d_start)
+    slipped_ = false;
+    if constexpr (kD) {
+      run_d_[0].clear();
+      run_d_[1].clear();
+      dense_q_.clear();
+    }
+  }
+  // Bookkeeping of the derivative of the current period (see LinearizedPeriod).
+  std::optional<PeriodRecorder> recorder;
+  if constexpr (kD) recorder.emplace(*lin, n, coupled ? 0 : (two_d ? 2 : 1));
+  PeriodRecorder* rec = recorder ? &*recorder : nullptr;
+
+  for (int l = 0; l < n; ++l) {
+    Sample s;
+    s.l = l;
+    s.lp = (l == 0) ? n - 1 : l - 1;
+    s.wx = w(l, 0);
+    s.wy = two_d ? w(l, 1) : 0.0;
+    s.wpx = w(s.lp, 0);
+    s.wpy = two_d ? w(s.lp, 1) : 0.0;
+    double nl = has_normal ? n0 + kn * w(l, 2) : n0;
+    const bool pressed = nl > 0.0;
+    if (!pressed) nl = 0.0;
+    double nprev = has_normal ? n0 + kn * w(s.lp, 2) : n0;
+    s.pressed_prev = nprev > 0.0;
+    if (!s.pressed_prev) nprev = 0.0;
+    s.nprev = nprev;
+    s.lim = mu * nl;
+    if constexpr (kD) rec->set_pressed(l, pressed && has_normal);
+
+    std::array<double, 2> t{0.0, 0.0};
+    if (!pressed || !(s.lim > 0.0))
+      separate<kD>(s, basis, rec, track);
+    else if (coupled && !exact)
+      t = coupled_radial_return<kD>(pair, s, basis, rec, track);
+    else if (coupled)
+      t = coupled_exact_linear<kD>(pair, s, basis, rec, track);
+    else
+      t = uncoupled<kD>(pair, s, rec);
+    f(l, 0) = t[0];
+    f(l, 1) = t[1];
+    f(l, 2) = has_normal ? nl : 0.0;
+  }
+}
+
+template PeriodicStatus PeriodicLaw::run<true>(const PairParameters&, const Eigen::MatrixX3d&,
+                                               Eigen::MatrixX3d&, const Eigen::MatrixXd*,
+                                               LinearizedPeriod*);
+template PeriodicStatus PeriodicLaw::run<false>(const PairParameters&, const Eigen::MatrixX3d&,
+                                                Eigen::MatrixX3d&, const Eigen::MatrixXd*,
+                                                LinearizedPeriod*);
+
+}  // namespace shroudsim::contact

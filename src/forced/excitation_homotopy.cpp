@@ -1,0 +1,66 @@
+#include "forced/excitation_homotopy.hpp"
+
+#include <algorithm>
+
+namespace shroudsim::forced {
+
+namespace {
+
+/// r(W, s) = W - s W_lin + G F(W) at a fixed frequency: lambda is the excitation scale.
+class ExcitationHomotopy : public continuation::ParametricResidual {
+ public:
+  ExcitationHomotopy(ReducedEquations& eq, double frequency_hz) : eq_(eq), frequency_hz_(frequency_hz) {}
+  int size() const override { return eq_.size(); }
+  bool has_lambda_derivative() const override { return true; }
+  bool evaluate(const Eigen::VectorXd& w, double s, Eigen::VectorXd& r, Eigen::MatrixXd* J,
+                Eigen::VectorXd* dl) override {
+    eq_.set_excitation_scale(s);
+    const bool ok = eq_.evaluate(w, frequency_hz_, r, J, nullptr);
+    if (dl) *dl = -lin_;
+    return ok;
+  }
+  bool solve_augmented(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override {
+    return eq_.solve_augmented(A, b, d);
+  }
+  // dR/dW is the equations' own J: their matrix-free solves serve the homotopy too.
+  bool matrix_free() const override { return eq_.matrix_free(); }
+  bool linearize(const Eigen::VectorXd& w, double s, Eigen::VectorXd& r, Eigen::VectorXd* dl) override {
+    eq_.set_excitation_scale(s);
+    const bool ok = eq_.linearize(w, frequency_hz_, r, nullptr);
+    if (dl) *dl = -lin_;
+    return ok;
+  }
+  bool solve_bordered(const continuation::BorderedMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& d) override {
+    return eq_.solve_bordered(A, b, d);
+  }
+  Eigen::VectorXd lin_;
+
+ private:
+  ReducedEquations& eq_;
+  double frequency_hz_;
+};
+
+}  // namespace
+
+continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, double frequency_hz,
+                                                  const continuation::ArclengthOptions& options, Eigen::VectorXd& w) {
+  ExcitationHomotopy homotopy(equations, frequency_hz);
+  homotopy.lin_ = equations.linear_motion(frequency_hz);
+  continuation::ArclengthOptions o = options;
+  o.lambda_start = 0.0;
+  o.lambda_end = 1.0;
+  o.lambda_scale = 1.0;
+  o.initial_step = 0.05;
+  o.max_step = 4.0;
+  o.max_points = std::min(o.max_points, 2000);  // a start that needs more is not worth waiting for
+  o.start_slack = 1.0;  // the path may fold back through s < 0 (the excitation reversed)
+  const double saved = equations.excitation_scale();
+  equations.set_excitation_scale(0.0);
+  const Eigen::VectorXd start = equations.stuck_solution(frequency_hz);
+  continuation::Branch b = continuation::trace(homotopy, start, o);
+  equations.set_excitation_scale(saved);
+  if (b.status == continuation::BranchStatus::kReachedEnd) w = b.points.back().x;
+  return b;
+}
+
+}  // namespace shroudsim::forced

@@ -1,0 +1,27 @@
+#pragma once
+// A solution of the reduced equations (forced/reduced_equations.hpp) at one frequency f by
+// continuation in the excitation scale s (docs/continuation.md, the start of a frequency
+// response):
+//
+//     r(W, s) = W - s W_lin(f) + G(f) F(W) = 0,      dr/ds = -W_lin(f),      s: 0 -> 1,
+//
+// traced by the pseudo-arclength continuation (continuation/arclength.hpp) from the stuck
+// solution at s = 0 (preload only, exact when the preload alone does not slip) to s = 1, the
+// case itself. Robust where Newton from a guess cycles between contact states. The path may
+// fold back through s < 0 (the excitation reversed); at most 2000 points are traced. The
+// equations' dR/dW and linear solvers (dense or matrix-free) serve the homotopy unchanged.
+#include <Eigen/Core>
+
+#include "continuation/arclength.hpp"
+#include "forced/reduced_equations.hpp"
+
+namespace shroudsim::forced {
+
+/// The continuation in s at `frequency_hz` [Hz] with `options`' tolerances and scales
+/// (lambda range, steps and point cap are set here). Returns the branch; on
+/// BranchStatus::kReachedEnd, w holds the solution at s = 1. equations' excitation scale is
+/// restored before returning.
+continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, double frequency_hz,
+                                                  const continuation::ArclengthOptions& options, Eigen::VectorXd& w);
+
+}  // namespace shroudsim::forced
