@@ -66,8 +66,8 @@ struct Sweep {
 
 int cmd_campbell(Context& ctx) {
   const io::Case& c = ctx.config;
-  if (c.structure.type != "sector")
-    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type +
+  if (c.structure.type != io::StructureType::sector)
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
                      "\": `campbell` needs an FE sector (structure.type = \"sector\")");
   if (c.campbell.speed_rpm.size() != 2 || !(c.campbell.speed_rpm[0] >= 0.0) ||
       !(c.campbell.speed_rpm[1] > c.campbell.speed_rpm[0]))
