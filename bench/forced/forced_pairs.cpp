@@ -64,7 +64,8 @@ int main(int argc, char** argv) {
     ctx.plots = false;
     ctx.out_dir = "/tmp";
     const io::Case& c = ctx.config;
-    app::ForcedModel model = c.structure.type == "lumped" ? app::make_lumped_model(c) : app::make_sector_model(ctx);
+    app::ForcedModel model = c.structure.type == io::StructureType::lumped ? app::make_lumped_model(c)
+                                                                           : app::make_sector_model(ctx);
     const hbm::ContactEvaluatorOptions eo = app::evaluator_options(c, threads);
     hbm::ContactEvaluator evaluator(eo, model.pairs);
     forced::ReducedEquations equations(*model.linear, evaluator);
@@ -114,9 +115,10 @@ int main(int argc, char** argv) {
     const double seconds = clock.seconds();
     const forced::SolverStatistics& s = equations.statistics();
     std::cout << std::setprecision(4) << "pairs=" << evaluator.n_pairs() << " unknowns=" << equations.size()
-              << " jacobian=" << c.hbm.jacobian << " N=" << c.hbm.time_samples << " preload=" << c.contact.normal_preload
-              << " solver=" << solver << " status=" << continuation::to_string(b.status) << " points=" << b.points.size()
-              << " start=" << how << " seconds=" << seconds - check_seconds << " start_seconds=" << start_seconds
+              << " jacobian=" << hbm::to_string(c.hbm.jacobian) << " N=" << c.hbm.time_samples
+              << " preload=" << c.contact.normal_preload << " solver=" << solver
+              << " status=" << continuation::to_string(b.status) << " points=" << b.points.size() << " start=" << how
+              << " seconds=" << seconds - check_seconds << " start_seconds=" << start_seconds
               << " newton=" << b.newton_iterations << " evaluations=" << s.evaluations
               << " jacobian_evaluations=" << s.jacobian_evaluations << " repeated=" << s.repeated_evaluations
               << " contact_s=" << s.contact_seconds << " receptance_s=" << s.receptance_seconds

@@ -17,6 +17,7 @@
 #include "io/output.hpp"
 #include "io/case.hpp"
 #include "io/results_folder.hpp"
+#include "io/schema.hpp"
 
 namespace shroudsim::app {
 namespace {
@@ -89,8 +90,10 @@ void print_summary(const Context& ctx, const std::string& command, double second
 int run_cli(int argc, char** argv) {
   CLI::App app{"shroudsim: friction damping of shrouded bladed disks (cyclic FE + multiharmonic balance)"};
   app.require_subcommand(0, 1);
-  bool print_defaults = false, version = false;
+  bool print_defaults = false, print_reference = false, version = false;
   app.add_flag("--print-defaults", print_defaults, "print a complete commented case file with every default");
+  app.add_flag("--print-case-reference", print_reference,
+               "print the reference of every case key (Markdown: docs/case_keys.md)");
   app.add_flag("--version", version, "print the version");
 
   struct Sub {
@@ -132,6 +135,10 @@ int run_cli(int argc, char** argv) {
   }
   if (print_defaults) {
     std::cout << io::default_case_text();
+    return 0;
+  }
+  if (print_reference) {
+    std::cout << io::case_reference_markdown();
     return 0;
   }
   if (version) {

@@ -29,20 +29,10 @@ namespace shroudsim::app {
 
 int cmd_campbell(Context& ctx) {
   const io::Case& c = ctx.config;
-  if (c.structure.type != "sector")
-    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type +
+  if (c.structure.type != io::StructureType::sector)
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
                      "\": `campbell` needs an FE sector (structure.type = \"sector\")");
-  if (c.campbell.speed_rpm.size() != 2 || !(c.campbell.speed_rpm[0] >= 0.0) ||
-      !(c.campbell.speed_rpm[1] > c.campbell.speed_rpm[0]))
-    throw InputError(c.where("campbell.speed_rpm") + ": campbell.speed_rpm violates: [min, max] with 0 <= min < max");
-  if (c.campbell.speed_points < 2)
-    throw InputError(c.where("campbell.speed_points") + ": campbell.speed_points = " +
-                     std::to_string(c.campbell.speed_points) + " violates: speed_points >= 2");
   const int nb = c.structure.sectors;
-  for (int e : c.campbell.engine_orders)
-    if (e < 1)
-      throw InputError(c.where("campbell.engine_orders") + ": campbell.engine_orders contains " + std::to_string(e) +
-                       ", which violates: engine orders >= 1");
 
   // The [modal] harmonic indices plus those the engine orders excite.
   std::vector<int> hs = modal_harmonic_indices(c);

@@ -160,9 +160,9 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
   hbm::ContactEvaluatorOptions o;
   o.n_harmonics = c.hbm.harmonics;
   o.n_time_samples = c.hbm.time_samples;
-  o.law.model = *contact::parse_model(c.contact.model);
-  o.law.update = *contact::parse_update(c.contact.tangential_update);
-  o.jacobian = *hbm::parse_jacobian(c.hbm.jacobian);
+  o.law.model = c.contact.model;
+  o.law.update = c.contact.tangential_update;
+  o.jacobian = c.hbm.jacobian;
   o.threads = threads;
   // FFTW_MEASURE picks plans by timing, so round-off (and with it a Newton path through
   // nonsmooth contact states) would change from run to run: estimated plans are reproducible.
@@ -194,10 +194,10 @@ int cmd_frf(Context& ctx) {
   }
   if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return frf_auto(ctx);
   log::Stopwatch clock;
-  ForcedModel model = c.structure.type == "lumped" ? make_lumped_model(c) : make_sector_model(ctx);
+  ForcedModel model = c.structure.type == io::StructureType::lumped ? make_lumped_model(c) : make_sector_model(ctx);
   for (const auto& p : model.pairs) {
     std::vector<std::string> errors;
-    if (!p.validate(*contact::parse_model(c.contact.model), &errors)) {
+    if (!p.validate(c.contact.model, &errors)) {
       throw InputError(c.where("contact.model") + ": [contact]: " + errors.front());
     }
   }
@@ -207,7 +207,8 @@ int cmd_frf(Context& ctx) {
 
   log::info("frf: " + model.linear->describe() + ", " + std::to_string(evaluator.n_pairs()) + " contact pairs, " +
             std::to_string(equations.size()) + " unknowns (H = " + std::to_string(c.hbm.harmonics) +
-            ", N = " + std::to_string(c.hbm.time_samples) + ", " + c.contact.model + ", " + c.hbm.jacobian + " Jacobian)");
+            ", N = " + std::to_string(c.hbm.time_samples) + ", " + contact::to_string(c.contact.model) + ", " +
+            hbm::to_string(c.hbm.jacobian) + " Jacobian)");
   int reported = 0;
   auto progress = [&](const continuation::BranchPoint& p, int piece) {
     ++reported;

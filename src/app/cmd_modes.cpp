@@ -50,7 +50,9 @@ const cyclic::CyclicSector& ModalModel::cyclic() {
 }
 
 Shroud case_shroud(const io::Case& c) {
-  return c.modal.shroud == "stuck" ? Shroud::stuck : c.modal.shroud == "contact" ? Shroud::contact : Shroud::open;
+  return c.modal.shroud == io::ModalShroud::stuck     ? Shroud::stuck
+         : c.modal.shroud == io::ModalShroud::contact ? Shroud::contact
+                                                      : Shroud::open;
 }
 
 std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mesh::Mesh& mesh) {
@@ -58,7 +60,8 @@ std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mes
     return frf::face_springs(mesh, frf::shroud_face(mesh), c.contact.normal_stiffness, c.contact.tangential_stiffness,
                              c.contact.frame_angle_deg * std::numbers::pi / 180.0);
   } catch (const std::invalid_argument& e) {
-    throw InputError(c.where("modal.shroud") + ": modal.shroud = \"" + c.modal.shroud + "\": " + e.what());
+    throw InputError(c.where("modal.shroud") + ": modal.shroud = \"" + io::to_string(c.modal.shroud) +
+                     "\": " + e.what());
   }
 }
 
@@ -97,11 +100,8 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   const int nb = model.mesh.sectors > 0 ? model.mesh.sectors : c.structure.sectors;
   model.mesh.sectors = nb;
   model.material = {c.material.youngs_modulus, c.material.poisson_ratio, c.material.density};
-  if (!model.material.valid())
-    throw InputError(c.where("material.youngs_modulus") +
-                     ": [material] violates: youngs_modulus > 0, -1 < poisson_ratio < 0.5, density > 0");
   model.options.modes = c.modal.modes;
-  model.options.method = c.modal.eigensolver == "spectra" ? modal::EigenMethod::Spectra : modal::EigenMethod::Block;
+  model.options.method = c.modal.eigensolver;
   std::vector<std::string> errors;
   if (!model.options.validate(&errors)) throw InputError(c.where("modal.modes") + ": modal." + errors.front());
 
@@ -296,8 +296,8 @@ void draw_plots(Context& ctx) {
 
 int cmd_modes(Context& ctx) {
   const io::Case& c = ctx.config;
-  if (c.structure.type != "sector")
-    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type +
+  if (c.structure.type != io::StructureType::sector)
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
                      "\": `modes` needs an FE sector (structure.type = \"sector\")");
   ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), /*keep_factors=*/false, 0.0, case_shroud(c));
   write_modes_csv(ctx, model);

@@ -33,8 +33,8 @@ frf::StaticShroudSettings static_shroud_settings(const io::Case& c, double speed
 
 int cmd_static(Context& ctx) {
   const io::Case& c = ctx.config;
-  if (c.structure.type != "sector")
-    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type +
+  if (c.structure.type != io::StructureType::sector)
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
                      "\": `static` needs an FE sector");
   ModalModel model = run_modal_stage(ctx, {}, /*keep_factors=*/false);
   log::Stopwatch clock;

@@ -59,8 +59,9 @@ void describe_mesh(Context& ctx, const mesh::Mesh& m, const fs::path& file, bool
 
 mesh::Mesh obtain_mesh(Context& ctx) {
   const io::Case& c = ctx.config;
-  if (c.structure.type != "sector")
-    throw InputError(c.where("structure.type") + ": structure.type = \"" + c.structure.type + "\" has no mesh (meshes are for structure.type = \"sector\")");
+  if (c.structure.type != io::StructureType::sector)
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
+                     "\" has no mesh (meshes are for structure.type = \"sector\")");
   // gmsh is one global session per process, and study points sharing a case name share its
   // mesh file: one mesh stage at a time (generation, key and read stay consistent).
   static std::mutex mesh_stage_mutex;

@@ -8,7 +8,7 @@
 namespace shroudsim::app {
 
 int cmd_run(Context& ctx) {
-  if (ctx.config.structure.type == "lumped") return cmd_frf(ctx);
+  if (ctx.config.structure.type == io::StructureType::lumped) return cmd_frf(ctx);
   const io::Case& c = ctx.config;
   // Inputs that only the forced response reads, checked on the mesh before any modal work.
   check_forced_points(c, obtain_mesh(ctx));

@@ -87,8 +87,7 @@ ForcedModel make_sector_model(Context& ctx) {
 
   const std::vector<frf::ShroudFaceNode> face = frf::shroud_face(mesh);
   if (face.empty()) throw InputError(c.file.string() + ": the mesh has no matched shroud node pairs");
-  frf::ContactDiscretization discretization = frf::ContactDiscretization::patches;
-  frf::parse_discretization(c.contact.discretization, discretization);  // checked by the case reader
+  const frf::ContactDiscretization discretization = c.contact.discretization;
   // Each patch gets the share A_P / A of the face's stiffness and preload.
   std::vector<frf::ContactPatch> patches;
   try {
@@ -124,7 +123,7 @@ ForcedModel make_sector_model(Context& ctx) {
   ctx.report.stage("receptances", clock.seconds());
   auto& j = ctx.report.section("frf_model");
   j["contact_pairs"] = pairs.size();
-  j["contact_discretization"] = c.contact.discretization;
+  j["contact_discretization"] = frf::to_string(c.contact.discretization);
   j["shroud_pairs_available"] = face.size();
   j["contact_area_m2"] = total;
   if (static_state) {

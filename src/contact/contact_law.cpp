@@ -5,20 +5,6 @@
 
 namespace shroudsim::contact {
 
-std::optional<Model> parse_model(std::string_view text) {
-  if (text == "full3d") return Model::full3d;
-  if (text == "quasi3d") return Model::quasi3d;
-  if (text == "1d") return Model::one_d;
-  if (text == "1d_exact") return Model::one_d_exact;
-  return std::nullopt;
-}
-
-std::optional<TangentialUpdate> parse_update(std::string_view text) {
-  if (text == "radial_return") return TangentialUpdate::radial_return;
-  if (text == "exact_linear") return TangentialUpdate::exact_linear;
-  return std::nullopt;
-}
-
 std::string to_string(Model model) {
   switch (model) {
     case Model::full3d: return "full3d";

@@ -36,10 +36,8 @@ enum class TangentialUpdate {
   exact_linear    ///< w_t linear within a step, integrated exactly (2nd order in 2D)
 };
 
-std::optional<Model> parse_model(std::string_view text);               ///< "full3d", "quasi3d", "1d", "1d_exact"
-std::optional<TangentialUpdate> parse_update(std::string_view text);  ///< "radial_return", "exact_linear"
-std::string to_string(Model model);
-std::string to_string(TangentialUpdate update);
+std::string to_string(Model model);              ///< "full3d", "quasi3d", "1d", "1d_exact" (contact.model)
+std::string to_string(TangentialUpdate update);  ///< "radial_return", "exact_linear" (contact.tangential_update)
 
 /// Directions a model uses: 3 (x, y, z) or 1 (x) for the 1d models.
 int n_directions(Model model);

@@ -109,12 +109,7 @@ std::vector<ContactPatch> partition_face(const mesh::Mesh& m, const std::vector<
   return patches;
 }
 
-bool parse_discretization(const std::string& s, ContactDiscretization& out) {
-  if (s == "patches") out = ContactDiscretization::patches;
-  else if (s == "nodes") out = ContactDiscretization::nodes;
-  else return false;
-  return true;
-}
+std::string to_string(ContactDiscretization d) { return d == ContactDiscretization::nodes ? "nodes" : "patches"; }
 
 Eigen::Matrix3d contact_frame(const Eigen::Vector3d& n, const Eigen::Vector3d& x, double angle) {
   Eigen::Vector3d t1 = Eigen::Vector3d::UnitZ() - n.z() * n;  // axial direction in the plane

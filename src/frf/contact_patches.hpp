@@ -50,8 +50,7 @@ struct ContactPatch {
 std::vector<ContactPatch> partition_face(const mesh::Mesh& mesh, const std::vector<ShroudFaceNode>& face, int count);
 
 enum class ContactDiscretization { patches, nodes };
-/// "patches" | "nodes"; false for anything else.
-bool parse_discretization(const std::string& s, ContactDiscretization& out);
+std::string to_string(ContactDiscretization d);  ///< "patches", "nodes" (contact.discretization)
 
 /// The frame [t1; t2; n] (rows) at a point x of the face with unit normal n: t1 the axial
 /// direction projected on the contact plane (the radial one where the normal is nearly

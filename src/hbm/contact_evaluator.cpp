@@ -15,13 +15,6 @@
 
 namespace shroudsim::hbm {
 
-std::optional<JacobianMethod> parse_jacobian(std::string_view text) {
-  if (text == "analytic") return JacobianMethod::analytic;
-  if (text == "finite_difference") return JacobianMethod::finite_difference;
-  if (text == "finite_difference_full") return JacobianMethod::finite_difference_full;
-  return std::nullopt;
-}
-
 std::string to_string(JacobianMethod method) {
   switch (method) {
     case JacobianMethod::analytic: return "analytic";

@@ -40,8 +40,7 @@ enum class JacobianMethod {
   /// (the paper's Example 4 compares against it); for comparison only, it is slow.
   finite_difference_full
 };
-/// "analytic", "finite_difference", "finite_difference_full"
-std::optional<JacobianMethod> parse_jacobian(std::string_view text);
+/// "analytic", "finite_difference", "finite_difference_full" (hbm.jacobian)
 std::string to_string(JacobianMethod method);
 
 struct ContactEvaluatorOptions {

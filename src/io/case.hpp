@@ -1,8 +1,10 @@
 #pragma once
 // The case file (docs/contract.md), parsed and validated: plain data handed to app/,
-// which maps it onto each stage's own *Options. Every key has a default (see schema.cpp,
-// `shroudsim --print-defaults`). Units: SI, angles in degrees, frequencies in Hz,
-// speeds in rpm, as in the case file.
+// which maps it onto each stage's own *Options. Every key is declared once, in schema.cpp:
+// its default (set by Case's constructor), its checks, its documentation
+// (`shroudsim --print-defaults`, docs/case_keys.md). Units: SI, angles in degrees,
+// frequencies in Hz, speeds in rpm, as in the case file. Keys with one of a few words as
+// value are enums here (the stages' own where a stage has one); to_string gives the word.
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
@@ -11,72 +13,85 @@
 #include <string>
 #include <vector>
 
+#include "contact/contact_law.hpp"
+#include "frf/contact_patches.hpp"
+#include "hbm/contact_evaluator.hpp"
 #include "mesh/sector_generator.hpp"
+#include "modal/eigensolver.hpp"
 
 namespace shroudsim::io {
 
+/// structure.type
+enum class StructureType { sector, lumped };
+/// modal.shroud: the shroud contact of `modes` and `campbell` (docs/physics.md sections 1, 8).
+enum class ModalShroud { open, stuck, contact };
+std::string to_string(StructureType type);  ///< "sector", "lumped"
+std::string to_string(ModalShroud shroud);  ///< "open", "stuck", "contact"
+
+// The members below get their defaults from the schema (Case's constructor), not here.
+
 struct StructureSection {
-  std::string type = "sector";          ///< "sector" (FE) or "lumped"
-  int sectors = 8;                      ///< Nb >= 1
+  StructureType type;                   ///< FE sector or lumped M, K, C
+  int sectors;                          ///< Nb >= 1
   std::filesystem::path mesh;           ///< absolute path of a given mesh, empty: generate
   Eigen::MatrixXd mass, stiffness, damping;  ///< lumped only, n x n (damping may be empty)
 };
 
 struct GeometrySection {
-  double hub_radius = 0.10;
-  double disk_outer_radius = 0.16;
-  double disk_thickness = 0.03;
-  double blade_length = 0.25;
-  double blade_chord = 0.05;
-  double blade_thickness = 0.006;
-  double blade_twist_deg = 20.0;
-  double shroud_thickness = 0.006;
-  double shroud_width = 0.05;
-  double shroud_contact_angle_deg = 45.0;
-  int element_order = 2;
-  double mesh_size = 0.01;
-  double max_elements = 1.0e6;          ///< refuse to mesh when the estimated element count is larger
+  double hub_radius;
+  double disk_outer_radius;
+  double disk_thickness;
+  double blade_length;
+  double blade_chord;
+  double blade_thickness;
+  double blade_twist_deg;
+  double shroud_thickness;
+  double shroud_width;
+  double shroud_contact_angle_deg;
+  int element_order;
+  double mesh_size;
+  double max_elements;                  ///< refuse to mesh when the estimated element count is larger
 };
 
 struct MaterialSection {
-  double youngs_modulus = 210e9;
-  double poisson_ratio = 0.3;
-  double density = 7850.0;
+  double youngs_modulus;
+  double poisson_ratio;
+  double density;
 };
 
 struct ModalSection {
-  int modes = 50;
-  bool all_harmonic_indices = true;     ///< harmonic_indices = "all"
-  std::vector<int> harmonic_indices;    ///< when not all
-  double damping_ratio = 0.001;
-  bool residual_flexibility = true;
-  std::string eigensolver = "block";    ///< "block" (block Krylov-Schur) | "spectra" (Spectra's Lanczos)
-  std::string shroud = "open";          ///< "open" | "stuck" | "contact" (modes and campbell; docs/physics.md sections 1, 8)
+  int modes;
+  bool all_harmonic_indices;            ///< harmonic_indices = "all"
+  std::vector<int> harmonic_indices;    ///< when not all: sorted, without repeats
+  double damping_ratio;
+  bool residual_flexibility;
+  modal::EigenMethod eigensolver;       ///< block Krylov-Schur or Spectra's Lanczos
+  ModalShroud shroud;
 };
 
 struct CampbellSection {
-  std::vector<double> speed_rpm{0.0, 15000.0};  ///< [min, max]
-  int speed_points = 31;
-  std::vector<int> engine_orders{1, 2, 3, 4, 5, 6};
-  bool rotating_effects = false;
+  std::vector<double> speed_rpm;        ///< [min, max]
+  int speed_points;
+  std::vector<int> engine_orders;
+  bool rotating_effects;
 };
 
 struct StaticSection {
-  double speed_rpm = 0.0;
-  int increments = 10;
+  double speed_rpm;
+  int increments;
 };
 
 struct ExcitationSection {
-  int engine_order = 1;
-  std::array<double, 3> point{0.0, 0.35, 0.0};   ///< sector: nearest node
-  std::array<double, 3> force{1.0, 1.0, 1.0};    ///< N; lumped: force[0] only
-  int dof = 0;                                   ///< lumped only
-  double speed_rpm = 0.0;
+  int engine_order;
+  std::array<double, 3> point;          ///< sector: nearest node
+  std::array<double, 3> force;          ///< N; lumped: force[0] only
+  int dof;                              ///< lumped only
+  double speed_rpm;
 };
 
 struct ResponseSection {
-  std::array<double, 3> point{0.0, 0.34, 0.0};
-  int dof = 0;                                   ///< lumped only
+  std::array<double, 3> point;
+  int dof;                              ///< lumped only
 };
 
 /// A lumped contact element: one DOF per direction (-1: absent), to ground or to other DOFs.
@@ -88,38 +103,38 @@ struct ContactElement {
 };
 
 struct ContactSection {
-  std::string model = "full3d";          ///< full3d | quasi3d | 1d | 1d_exact
-  int pairs = 0;                         ///< 0: "all"
-  std::string discretization = "patches"; ///< "patches" | "nodes" (sector only)
-  double friction_coefficient = 0.3;
-  double normal_stiffness = 1.0e6;       ///< N/m per interface
-  double tangential_stiffness = 1.0e6;   ///< N/m per interface
-  double normal_preload = 0.25;          ///< N per interface, < 0: gap
-  bool normal_preload_static = false;    ///< "static": each patch's from the static shroud contact at excitation.speed_rpm
-  double frame_angle_deg = 0.0;
-  double interference = 0.0;            ///< sector: overlap of the shroud faces at rest [m]; < 0: a gap
-  std::string tangential_update = "exact_linear";  ///< or "radial_return"
-  std::vector<ContactElement> elements;  ///< lumped only
+  contact::Model model;
+  int pairs;                            ///< 0: "all"
+  frf::ContactDiscretization discretization;  ///< sector only
+  double friction_coefficient;
+  double normal_stiffness;              ///< N/m per interface
+  double tangential_stiffness;          ///< N/m per interface
+  double normal_preload;                ///< N per interface, < 0: gap
+  bool normal_preload_static;           ///< "static": each patch's from the static shroud contact at excitation.speed_rpm
+  double frame_angle_deg;
+  double interference;                  ///< sector: overlap of the shroud faces at rest [m]; < 0: a gap
+  contact::TangentialUpdate tangential_update;
+  std::vector<ContactElement> elements; ///< lumped only
 };
 
 struct HbmSection {
-  int harmonics = 5;                     ///< H (0 with harmonics_auto)
-  bool harmonics_auto = false;
-  int time_samples = 512;                ///< N
-  bool time_samples_auto = false;
-  std::string jacobian = "analytic";     ///< or "finite_difference"
-  double tolerance = 1e-8;
-  double energy_tolerance = 1e-3;        ///< energy-balance error above which a point fails the run
-  double auto_tolerance = 0.01;          ///< "auto": relative change of the peak amplitude to stop at
-  int auto_max_harmonics = 25;           ///< "auto": largest H tried
-  int auto_max_time_samples = 4096;      ///< "auto": largest N tried
+  int harmonics;                        ///< H (0 with harmonics_auto)
+  bool harmonics_auto;
+  int time_samples;                     ///< N (0 with time_samples_auto)
+  bool time_samples_auto;
+  hbm::JacobianMethod jacobian;
+  double tolerance;
+  double energy_tolerance;              ///< energy-balance error above which a point fails the run
+  double auto_tolerance;                ///< "auto": relative change of the peak amplitude to stop at
+  int auto_max_harmonics;               ///< "auto": largest H tried
+  int auto_max_time_samples;            ///< "auto": largest N tried
 };
 
 struct ContinuationSection {
-  double frequency_start_hz = 100.0;
-  double frequency_end_hz = 220.0;
-  double initial_step = 0.0;             ///< Hz-equivalent arclength; 0: "auto" (docs/continuation.md)
-  int max_points = 5000;
+  double frequency_start_hz;
+  double frequency_end_hz;
+  double initial_step;                  ///< Hz-equivalent arclength; 0: "auto" (docs/continuation.md)
+  int max_points;
 };
 
 /// One harmonic of a prescribed motion: x(t) += c cos(n w t) + s sin(n w t).
@@ -137,9 +152,10 @@ struct StudySection {
   std::vector<std::pair<std::string, std::vector<std::string>>> vary;
 };
 
-/// A parsed, validated case.
+/// A parsed, validated case. Default-constructed: every key at its schema default.
 struct Case {
-  std::string name = "shrouded_blade";
+  Case();
+  std::string name;
   std::filesystem::path file;            ///< the case file (absolute)
   std::filesystem::path directory;       ///< its folder: relative paths resolve here
   StructureSection structure;
@@ -155,10 +171,9 @@ struct Case {
   ContinuationSection continuation;
   MotionSection motion;
   StudySection study;
-  std::map<std::string, double> expect;
   /// Where each key came from: "file:line:col" or "file: --set key=value" (for messages
   /// of later stages about a key's value, e.g. a mesh that fails its checks).
-  std::map<std::string, std::string> locations;  ///< [expect]: regression expectations (free keys)
+  std::map<std::string, std::string> locations;
   /// "file:line:col" (or "file: --set key=value") of a key when known, else the case file:
   /// the head of a later stage's message about that key.
   std::string where(const std::string& key) const {

@@ -8,7 +8,7 @@
 namespace shroudsim::study {
 
 std::vector<Knob> convergence_knobs(const io::Case& c) {
-  const bool sector = c.structure.type == "sector";
+  const bool sector = c.structure.type == io::StructureType::sector;
   auto num = [](double v) { return io::format_number(v); };
   auto quoted = [](const std::string& v) { return "\"" + v + "\""; };
   std::vector<Knob> knobs;
@@ -28,7 +28,7 @@ std::vector<Knob> convergence_knobs(const io::Case& c) {
   }
   const int h = c.hbm.harmonics_auto ? 5 : c.hbm.harmonics;
   const int n = c.hbm.time_samples_auto ? 512 : c.hbm.time_samples;
-  if (c.contact.model != "1d_exact") {
+  if (c.contact.model != contact::Model::one_d_exact) {
     std::vector<std::string> hs;
     for (int v : {1, 3, h, 2 * h})
       if (v >= 1 && 2 * v + 1 <= 4 * n && (hs.empty() || std::to_string(v) != hs.back()) && v <= 200)
@@ -41,7 +41,7 @@ std::vector<Knob> convergence_knobs(const io::Case& c) {
       if (v >= std::max(16, 2 * h + 1) && v <= 65536) ns.push_back(std::to_string(v));
     ns.erase(std::unique(ns.begin(), ns.end()), ns.end());
     knobs.push_back({"time samples N", "hbm.time_samples", ns, {}});
-    if (c.contact.model == "full3d" || c.contact.model == "quasi3d") {
+    if (c.contact.model == contact::Model::full3d || c.contact.model == contact::Model::quasi3d) {
       knobs.push_back({"tangential update", "contact.tangential_update", {quoted("radial_return"), quoted("exact_linear")},
                        {{"hbm.time_samples", std::to_string(4 * n)}}});
       knobs.push_back({"contact model", "contact.model", {quoted("quasi3d"), quoted("full3d")}, {}});

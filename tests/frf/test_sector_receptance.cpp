@@ -161,11 +161,11 @@ TEST(SectorForced, EnergyBalanceAndOpenGapOnTheSector) {
   const SectorLinearPart part(*f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); },
                               pairs, forcing, 3);
   const double f_hz = 0.8 * bases.at(1).omega[0] / (2 * std::numbers::pi);
-  for (const char* model : {"1d", "quasi3d"}) {
+  for (const contact::Model model : {contact::Model::one_d, contact::Model::quasi3d}) {
     hbm::ContactEvaluatorOptions o;
     o.n_harmonics = 3;
     o.n_time_samples = 64;
-    o.law.model = *contact::parse_model(model);
+    o.law.model = model;
     o.threads = 1;
     hbm::ContactEvaluator ev(o, params);
     forced::ReducedEquations eq(part, ev);
@@ -174,11 +174,11 @@ TEST(SectorForced, EnergyBalanceAndOpenGapOnTheSector) {
     ao.tolerance = 1e-9;
     Eigen::VectorXd w;
     const auto b = forced::solve_by_excitation_homotopy(eq, f_hz, ao, w);
-    ASSERT_EQ(b.status, continuation::BranchStatus::kReachedEnd) << model << ": " << b.message;
+    ASSERT_EQ(b.status, continuation::BranchStatus::kReachedEnd) << contact::to_string(model) << ": " << b.message;
     const forced::PointResult r = eq.analyse(w, f_hz);
     // Excitation work = modal viscous + contact dissipation, to the Newton tolerance.
-    EXPECT_LT(r.energy_error, 1e-5) << model;
-    EXPECT_GT(r.contact_dissipation, 0.0) << model;
+    EXPECT_LT(r.energy_error, 1e-5) << contact::to_string(model);
+    EXPECT_GT(r.contact_dissipation, 0.0) << contact::to_string(model);
   }
   // A gap that never closes: the free response.
   for (auto& p : params) p.normal_preload = -1e3;  // gap of 5 mm

@@ -48,7 +48,7 @@ TEST(Case, OverridesApplyAndAreValidated) {
   const Case c = parse_case("[hbm]\nharmonics = 3\n", "case.toml",
                             {"hbm.harmonics=7", "contact.model=quasi3d", "modal.harmonic_indices=[0, 2, 2, 1]"});
   EXPECT_EQ(c.hbm.harmonics, 7);
-  EXPECT_EQ(c.contact.model, "quasi3d");
+  EXPECT_EQ(c.contact.model, contact::Model::quasi3d);
   EXPECT_EQ(c.modal.harmonic_indices, (std::vector<int>{0, 1, 2}));
   const std::string e = error_of("", {"hbm.harmonics=0"});
   EXPECT_NE(e.find("--set hbm.harmonics=0"), std::string::npos) << e;

@@ -40,10 +40,10 @@ TEST(TradeDesign, AGeneratedSectorVariesEveryKnobAndItsMeshDoublesTheDofsPerStep
 
 TEST(TradeDesign, TheExactOneDimensionalLawHasNoSamplingKnobs) {
   io::Case c;
-  c.structure.type = "lumped";
-  c.contact.model = "1d_exact";
+  c.structure.type = io::StructureType::lumped;
+  c.contact.model = contact::Model::one_d_exact;
   EXPECT_TRUE(study::convergence_knobs(c).empty());
-  c.contact.model = "1d";
+  c.contact.model = contact::Model::one_d;
   const auto knobs = study::convergence_knobs(c);
   EXPECT_EQ(find(knobs, "geometry.mesh_size"), nullptr);
   EXPECT_EQ(find(knobs, "contact.model"), nullptr);  // 1d has no quasi3d / full3d alternative
