@@ -4,7 +4,9 @@
 #   tools/setup.sh demo   runs the default case end to end (cases/shrouded_blade.toml)
 #   tools/setup.sh test   runs the whole test suite (ctest)
 #   tools/setup.sh build  only installs and builds
-# Needs root (or sudo) only when a package is missing.
+# Needs root (or sudo) only when a package is missing. SHROUDSIM_BUILD_DIR (default build)
+# names the build folder; SHROUDSIM_CMAKE_ARGS adds configure options (the CI passes
+# -DSHROUDSIM_WERROR=ON).
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
@@ -34,7 +36,8 @@ fi
 
 jobs="$(nproc 2>/dev/null || echo 2)"
 build="${SHROUDSIM_BUILD_DIR:-build}"
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# shellcheck disable=SC2086  # SHROUDSIM_CMAKE_ARGS is a list of options
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release ${SHROUDSIM_CMAKE_ARGS:-} >/dev/null
 if ! cmake --build "$build" -j "$jobs" >"$build/build.log" 2>&1; then
   grep -E -A5 "error" "$build/build.log" | head -60 >&2
   echo "setup: the build failed (full log: $build/build.log)" >&2

@@ -201,7 +201,9 @@ TEST(CliShroud, TheShroudClosesAtSpeedAndCampbellFollowsTheContact) {
   for (std::size_t i = 1; i < campbell.size(); ++i) {
     const auto& v = campbell[i];
     const std::pair<int, int> key{std::stoi(v[1]), std::stoi(v[3])};
-    if (std::stod(v[0]) == 0.0) EXPECT_NEAR(std::stod(v[4]), open.at(key), 1e-6 * open.at(key));
+    if (std::stod(v[0]) == 0.0) {
+      EXPECT_NEAR(std::stod(v[4]), open.at(key), 1e-6 * open.at(key));
+    }
     if (std::stod(v[0]) == 3000.0) top[key] = std::stod(v[4]);
   }
   // Closed shrouds couple the blades: ND 18 (neighbours in antiphase) well above ND 0.

@@ -56,7 +56,7 @@ void check_partition_of_unity_and_nodality() {
   for (int d = 0; d < 3; ++d) {
     Eigen::Vector3d e = Eigen::Vector3d::Zero();
     e(d) = kStep;
-    const auto fd = (TetShape<NPE>::values(xi + e) - TetShape<NPE>::values(xi - e)) / (2 * kStep);
+    const auto fd = ((TetShape<NPE>::values(xi + e) - TetShape<NPE>::values(xi - e)) / (2 * kStep)).eval();
     EXPECT_LT((fd - TetShape<NPE>::gradients(xi).col(d)).norm(), 1e-8);
   }
 }
