@@ -13,8 +13,8 @@ namespace {
 
 using namespace shroudsim;
 
-const contact::PairParameters kPair{.tangential_stiffness = 2e5, .normal_stiffness = 5e5,
-                                    .friction_coefficient = 0.4, .normal_preload = 3.0};
+const contact::PairParameters kPair{
+    .tangential_stiffness = 2e5, .normal_stiffness = 5e5, .friction_coefficient = 0.4, .normal_preload = 3.0};
 
 struct Setup {
   std::unique_ptr<hbm::ContactEvaluator> ev;
@@ -36,13 +36,13 @@ Setup make(const benchmark::State& state, int pairs = 1, int threads = 1) {
   std::mt19937 rng(42);
   const int n = s.ev->pair_layout().size();
   s.w.resize(s.ev->size());
-  for (int p = 0; p < pairs; ++p) s.w.segment(p * n, n) = testing::random_contact_state(s.ev->pair_layout(), kPair, rng);
+  for (int p = 0; p < pairs; ++p)
+    s.w.segment(p * n, n) = testing::random_contact_state(s.ev->pair_layout(), kPair, rng);
   return s;
 }
 
 void label(benchmark::State& state, const Setup& s) {
-  state.SetLabel(contact::to_string(s.ev->options().law.model) + "/" +
-                 contact::to_string(s.ev->options().law.update));
+  state.SetLabel(contact::to_string(s.ev->options().law.model) + "/" + contact::to_string(s.ev->options().law.update));
 }
 
 void BM_Residual(benchmark::State& state) {
@@ -97,5 +97,9 @@ void per_model(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_Residual)->Apply(per_model);
 BENCHMARK(BM_AnalyticJacobian)->Apply(per_model);
 BENCHMARK(BM_FiniteDifferenceJacobian)->Apply(per_model);
-BENCHMARK(BM_FiftyPairsAnalytic)->Args({0, 1, 5, 512, 1})->Args({0, 1, 5, 512, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FiftyPairsAnalytic)
+    ->Args({0, 1, 5, 512, 1})
+    ->Args({0, 1, 5, 512, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_MAIN();

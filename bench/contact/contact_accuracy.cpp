@@ -31,7 +31,9 @@ contact::PairParameters pair_params() {
 }
 
 void jacobian_table(int states) {
-  std::printf("## Jacobian: analytic vs central differences (relative Frobenius error per pair, %d seeded random states)\n\n", states);
+  std::printf(
+      "## Jacobian: analytic vs central differences (relative Frobenius error per pair, %d seeded random states)\n\n",
+      states);
   std::printf("| model | update | H | N | median | max | periods (max) |\n|---|---|---|---|---|---|---|\n");
   const contact::PairParameters p = pair_params();
   const std::vector<std::pair<contact::Model, contact::TangentialUpdate>> cases{
@@ -57,8 +59,7 @@ void jacobian_table(int states) {
         std::mt19937 rng(1000 * h + n);
         const int s = ev.pair_layout().size();
         Eigen::VectorXd w(ev.size());
-        for (int i = 0; i < states; ++i)
-          w.segment(i * s, s) = testing::random_contact_state(ev.pair_layout(), p, rng);
+        for (int i = 0; i < states; ++i) w.segment(i * s, s) = testing::random_contact_state(ev.pair_layout(), p, rng);
         Eigen::VectorXd fa, ff;
         std::vector<Eigen::MatrixXd> ja, jf;
         const auto st = ev.evaluate(w, fa, &ja, hbm::JacobianMethod::analytic);
@@ -71,8 +72,7 @@ void jacobian_table(int states) {
         }
         std::printf("| %s | %s | %d | %d | %.1e | %.1e | %d |\n", contact::to_string(model).c_str(),
                     model == contact::Model::one_d_exact ? "-" : contact::to_string(update).c_str(), h,
-                    model == contact::Model::one_d_exact ? 0 : n, testing::median(err), mx,
-                    st.max_periods);
+                    model == contact::Model::one_d_exact ? 0 : n, testing::median(err), mx, st.max_periods);
         std::fflush(stdout);
       }
     }
@@ -103,11 +103,13 @@ void update_table() {
   const auto rr = contact::TangentialUpdate::radial_return;
   const auto el = contact::TangentialUpdate::exact_linear;
   std::printf("\n## radial_return vs exact_linear: relative errors against references\n\n");
-  std::printf("1D Jenkins (model 1d, x = 4 a_slip cos), |F1 - F1_exact|/|F1_exact|; circle (full3d, z = 0, r = 4 a_slip): "
-              "energy per cycle vs 2 pi r mu N sqrt(1 - (a_slip/r)^2) and lead-angle error [rad]; ellipse "
-              "(full3d, x = 4 a_slip cos, y = 2 a_slip sin(t + 1), z = 0.5 N0/kn cos 2t): energy vs exact_linear at N = 65536 (H = 5)\n\n");
-  std::printf("| N | 1D radial_return | 1D exact_linear | circle energy radial_return | circle energy exact_linear | "
-              "circle lead radial_return | circle lead exact_linear | ellipse energy radial_return | ellipse energy exact_linear |\n");
+  std::printf(
+      "1D Jenkins (model 1d, x = 4 a_slip cos), |F1 - F1_exact|/|F1_exact|; circle (full3d, z = 0, r = 4 a_slip): "
+      "energy per cycle vs 2 pi r mu N sqrt(1 - (a_slip/r)^2) and lead-angle error [rad]; ellipse "
+      "(full3d, x = 4 a_slip cos, y = 2 a_slip sin(t + 1), z = 0.5 N0/kn cos 2t): energy vs exact_linear at N = 65536 (H = 5)\n\n");
+  std::printf(
+      "| N | 1D radial_return | 1D exact_linear | circle energy radial_return | circle energy exact_linear | "
+      "circle lead radial_return | circle lead exact_linear | ellipse energy radial_return | ellipse energy exact_linear |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   // 1D
   const double a1d = 4.0 * a_slip;
@@ -147,8 +149,8 @@ void update_table() {
       ee[k] = std::abs(hbm::dissipated_energy(l5, we, fe) / e_ref - 1.0);
       ++k;
     }
-    std::printf("| %d | %.2e | %.2e | %.2e | %.2e | %.2e | %.2e | %.2e | %.2e |\n", n, e1d[0], e1d[1], ec[0],
-                ec[1], lc[0], lc[1], ee[0], ee[1]);
+    std::printf("| %d | %.2e | %.2e | %.2e | %.2e | %.2e | %.2e | %.2e | %.2e |\n", n, e1d[0], e1d[1], ec[0], ec[1],
+                lc[0], lc[1], ee[0], ee[1]);
     std::fflush(stdout);
   }
 }

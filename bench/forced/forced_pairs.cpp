@@ -48,7 +48,8 @@ int main(int argc, char** argv) {
     else if (a == "--jacobian-check") check = true;
     else if (case_file.empty() && a.rfind("--", 0) != 0) case_file = a;
     else {
-      std::cerr << "usage: forced_pairs CASE.toml [--set KEY=VALUE]... [--threads N] [--solver dense|krylov|auto] [--jacobian-check]\n";
+      std::cerr
+          << "usage: forced_pairs CASE.toml [--set KEY=VALUE]... [--threads N] [--solver dense|krylov|auto] [--jacobian-check]\n";
       return 2;
     }
   }
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
     hbm::ContactEvaluator evaluator(eo, model.pairs);
     forced::ReducedEquations equations(*model.linear, evaluator);
     forced::LinearSolverOptions so;
-    so.kind = solver == "dense" ? forced::LinearSolverOptions::Kind::dense
+    so.kind = solver == "dense"    ? forced::LinearSolverOptions::Kind::dense
               : solver == "krylov" ? forced::LinearSolverOptions::Kind::krylov
                                    : forced::LinearSolverOptions::Kind::automatic;
     equations.set_linear_solver(so);

@@ -58,9 +58,10 @@ int main(int argc, char** argv) {
     else if (a == "--block" && i + 1 < argc) block = std::atoi(argv[++i]);
     else if (a == "--ncv" && i + 1 < argc) ncv = std::atoi(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: modal_benchmark [--msh FILE] [--structured NR NT NZ NB] [--sectors NB] "
-                           "[--modes M] [--threads T] [--parallel] [--label TEXT] [--only-h H] "
-                           "[--method block|spectra] [--block B] [--ncv M]\n");
+      std::fprintf(stderr,
+                   "usage: modal_benchmark [--msh FILE] [--structured NR NT NZ NB] [--sectors NB] "
+                   "[--modes M] [--threads T] [--parallel] [--label TEXT] [--only-h H] "
+                   "[--method block|spectra] [--block B] [--ncv M]\n");
       return 2;
     }
   }
@@ -90,9 +91,11 @@ int main(int argc, char** argv) {
   watch.restart();
   const cyclic::CyclicSector sector(m, km);
   const double cyclic_s = watch.seconds();
-  std::printf("  assembly: pattern %.3f s + values %.3f s (%d threads), %ld stored entries; cyclic setup %.3f s; "
-              "%ld reduced DOFs\n", pattern_s, values_s, threads, static_cast<long>(km.K.nonZeros()), cyclic_s,
-              static_cast<long>(sector.n_reduced()));
+  std::printf(
+      "  assembly: pattern %.3f s + values %.3f s (%d threads), %ld stored entries; cyclic setup %.3f s; "
+      "%ld reduced DOFs\n",
+      pattern_s, values_s, threads, static_cast<long>(km.K.nonZeros()), cyclic_s,
+      static_cast<long>(sector.n_reduced()));
 
   modal::ModalOptions options;
   options.modes = modes;
@@ -114,11 +117,12 @@ int main(int argc, char** argv) {
       std::printf("  h = %d FAILED: %s\n", h, rep.message.c_str());
       return 3;
     }
-    std::printf("  h = %d (%s): total %.2f s = reduce+check %.2f s, factor %.2f s (nnz(L) %.3g), eigensolver %.2f s "
-                "(%d solves, %d M products, %d steps/restarts); f = %.2f .. %.2f Hz, max residual %.1e\n",
-                h, rep.method.c_str(), s, s - rep.factor_seconds - rep.solve_seconds, rep.factor_seconds,
-                rep.factor_nonzeros, rep.solve_seconds, rep.operations, rep.mass_products, rep.iterations, r.basis.frequency_hz()(0),
-                r.basis.frequency_hz()(r.basis.size() - 1), rep.max_residual);
+    std::printf(
+        "  h = %d (%s): total %.2f s = reduce+check %.2f s, factor %.2f s (nnz(L) %.3g), eigensolver %.2f s "
+        "(%d solves, %d M products, %d steps/restarts); f = %.2f .. %.2f Hz, max residual %.1e\n",
+        h, rep.method.c_str(), s, s - rep.factor_seconds - rep.solve_seconds, rep.factor_seconds, rep.factor_nonzeros,
+        rep.solve_seconds, rep.operations, rep.mass_products, rep.iterations, r.basis.frequency_hz()(0),
+        r.basis.frequency_hz()(r.basis.size() - 1), rep.max_residual);
     if (sector.is_real(h)) fac_real += rep.factor_seconds, lan_real += rep.solve_seconds, ++n_real;
     else fac_cplx += rep.factor_seconds, lan_cplx += rep.solve_seconds, ++n_cplx;
   }
@@ -140,13 +144,13 @@ int main(int argc, char** argv) {
     if (blas_before > 0) linalg::set_blas_threads(blas_before);
   }
   const double peak = log::peak_memory_mib();
-  std::printf("  all %d harmonic indices (%zu solves, conjugates for the rest): %.1f s sequential", nb, hs.size(), total);
+  std::printf("  all %d harmonic indices (%zu solves, conjugates for the rest): %.1f s sequential", nb, hs.size(),
+              total);
   if (parallel_s > 0) std::printf(", %.1f s with %d workers", parallel_s, threads);
   std::printf("; peak memory %.0f MiB\n", peak);
   std::printf("| %s | %d | %ld | %.2f | %.2f / %.2f | %.1f / %.1f | %.1f | %s | %.0f |\n", label.c_str(), m.n_dofs(),
-              static_cast<long>(sector.n_reduced()), pattern_s + values_s,
-              n_real ? fac_real / n_real : 0.0, n_cplx ? fac_cplx / n_cplx : 0.0,
-              n_real ? lan_real / n_real : 0.0, n_cplx ? lan_cplx / n_cplx : 0.0, total,
-              parallel_s > 0 ? (std::to_string(static_cast<int>(parallel_s + 0.5)) + " s").c_str() : "-", peak);
+              static_cast<long>(sector.n_reduced()), pattern_s + values_s, n_real ? fac_real / n_real : 0.0,
+              n_cplx ? fac_cplx / n_cplx : 0.0, n_real ? lan_real / n_real : 0.0, n_cplx ? lan_cplx / n_cplx : 0.0,
+              total, parallel_s > 0 ? (std::to_string(static_cast<int>(parallel_s + 0.5)) + " s").c_str() : "-", peak);
   return 0;
 }

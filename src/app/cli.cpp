@@ -14,8 +14,8 @@
 #include "app/context.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "io/output.hpp"
 #include "io/case.hpp"
+#include "io/output.hpp"
 #include "io/results_folder.hpp"
 #include "io/schema.hpp"
 
@@ -108,7 +108,9 @@ int run_cli(int argc, char** argv) {
       {"campbell", "frequencies against speed with engine-order lines -> campbell.csv, crossings.csv", cmd_campbell},
       {"frf", "nonlinear forced response with continuation -> frf.csv", cmd_frf},
       {"contact", "one contact pair under the prescribed motion of [motion] -> contact.json", cmd_contact},
-      {"static", "shroud contact of the spinning sector (interference, friction) -> static_contact.csv, contact_static.vtu", cmd_static},
+      {"static",
+       "shroud contact of the spinning sector (interference, friction) -> static_contact.csv, contact_static.vtu",
+       cmd_static},
       {"study", "the case over the [study] sweep -> one folder per point and study.csv", cmd_study},
   };
   std::vector<CommonOptions> options(subs.size());

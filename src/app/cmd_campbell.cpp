@@ -13,16 +13,16 @@
 #include <mutex>
 #include <sstream>
 
-#include "core/format.hpp"
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
-#include "linalg/parallel.hpp"
 #include "campbell/campbell.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/log.hpp"
+#include "frf/static_shroud.hpp"
 #include "io/output.hpp"
 #include "io/vtu.hpp"
-#include "frf/static_shroud.hpp"
+#include "linalg/parallel.hpp"
 #include "modal/rotating.hpp"
 
 namespace shroudsim::app {
@@ -102,14 +102,17 @@ int cmd_campbell(Context& ctx) {
       const int pairs = static_cast<int>(states.springs.size());
       for (int i = 0; i < states.solved(); ++i) {
         const int closed = static_cast<int>(std::count(states.closed[i].begin(), states.closed[i].end(), true));
-        per_speed.push_back({{"speed_rpm", rpm[i]}, {"closed", closed}, {"open", pairs - closed},
-                             {"slip", states.slipping[i]}, {"normal_load_n", states.normal_load_n[i]}});
+        per_speed.push_back({{"speed_rpm", rpm[i]},
+                             {"closed", closed},
+                             {"open", pairs - closed},
+                             {"slip", states.slipping[i]},
+                             {"normal_load_n", states.normal_load_n[i]}});
       }
-      report["shroud_contact"] = {{"states", per_speed}, {"seconds", static_clock.seconds()},
-                                  {"interference_m", c.contact.interference}};
+      report["shroud_contact"] = {
+          {"states", per_speed}, {"seconds", static_clock.seconds()}, {"interference_m", c.contact.interference}};
       const int closed_top = states.solved() > 0 ? per_speed.back()["closed"].get<int>() : 0;
-      log::info("campbell: static shroud contact at " + std::to_string(states.solved()) + " speeds: " +
-                std::to_string(closed_top) + " of " + std::to_string(pairs) + " pairs closed at " +
+      log::info("campbell: static shroud contact at " + std::to_string(states.solved()) +
+                " speeds: " + std::to_string(closed_top) + " of " + std::to_string(pairs) + " pairs closed at " +
                 io::format_number(states.solved() > 0 ? rpm[states.solved() - 1] : 0.0) + " rpm (" +
                 fixed(static_clock.seconds(), 2) + " s)");
     }
@@ -120,7 +123,7 @@ int cmd_campbell(Context& ctx) {
       for (int n = 0; n < model.mesh.n_nodes(); ++n) disp.row(n) = w2 * ops.displacement.segment<3>(3 * n).transpose();
       const Eigen::VectorXd vm = w2 * fe::nodal_von_mises(model.mesh, model.material, ops.displacement);
       io::write_point_fields_vtu(ctx.out_dir / "prestress.vtu", model.mesh,
-                             {{"centrifugal_displacement_m", disp}, {"von_mises_pa", Eigen::MatrixXd(vm)}});
+                                 {{"centrifugal_displacement_m", disp}, {"von_mises_pa", Eigen::MatrixXd(vm)}});
     }
     log::info("campbell: centrifugal prestress at " + io::format_number(s1) + " rpm: peak von Mises " +
               fixed(peak_top / 1e6, 1) + " MPa (element " + std::to_string(ops.peak.element) +
@@ -133,7 +136,8 @@ int cmd_campbell(Context& ctx) {
         const int h = canonical[k];
         campbell::HarmonicSweep s = campbell::sweep_harmonic(sweep_sector, rot, h, rpm, model.options, at_rest(h),
                                                              follow_contact ? &states : nullptr);
-        std::string line = "campbell h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
+        std::string line =
+            "campbell h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
         if (s.f.front().size() > 0 && s.f.back().size() > 0)
           line += "mode 1 " + fixed(s.f.front()(0), 2) + " Hz at " + io::format_number(s0) + " rpm -> " +
                   fixed(s.f.back()(0), 2) + " Hz at " + io::format_number(s1) + " rpm, ";
@@ -154,12 +158,14 @@ int cmd_campbell(Context& ctx) {
       const campbell::HarmonicSweep& s = sweeps.at(h);
       total += s.seconds;
       solves += s.solves;
-      nlohmann::json entry = {{"harmonic_index", h}, {"solves", s.solves}, {"seconds", s.seconds},
-                              {"factor_seconds", s.factor_seconds}, {"lanczos_seconds", s.lanczos_seconds},
+      nlohmann::json entry = {{"harmonic_index", h},
+                              {"solves", s.solves},
+                              {"seconds", s.seconds},
+                              {"factor_seconds", s.factor_seconds},
+                              {"lanczos_seconds", s.lanczos_seconds},
                               {"symbolic_analyses", s.analyses}};
       if (!s.failure.empty()) entry["failure"] = s.failure;
-      if (s.f.front().size() > 0 && s.f.back().size() > 0)
-        entry["mode1_hz"] = {s.f.front()(0), s.f.back()(0)};
+      if (s.f.front().size() > 0 && s.f.back().size() > 0) entry["mode1_hz"] = {s.f.front()(0), s.f.back()(0)};
       per_h.push_back(entry);
       if (!s.failure.empty()) model.failures.push_back(s.failure);
     }
@@ -203,13 +209,13 @@ int cmd_campbell(Context& ctx) {
   // a sweep stopped) is written after the command returns, so the plot of this run gets the
   // reason from the environment of the plotting process.
   // (Only when this command plots: study points run in threads and never plot.)
-  if (ctx.plots && !model.failures.empty())
-    ::setenv("SHROUDSIM_CAMPBELL_STOPPED", model.failures.front().c_str(), 1);
+  if (ctx.plots && !model.failures.empty()) ::setenv("SHROUDSIM_CAMPBELL_STOPPED", model.failures.front().c_str(), 1);
   draw_plots(ctx);
   if (!model.failures.empty()) {
     std::string msg = "modal analysis failed for";
     for (const auto& f : model.failures) msg += "\n  " + f;
-    throw NumericalError(msg + "\n(campbell.csv and crossings.csv hold the harmonic indices and speeds that converged)");
+    throw NumericalError(msg +
+                         "\n(campbell.csv and crossings.csv hold the harmonic indices and speeds that converged)");
   }
   return 0;
 }

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
-#include <sstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -46,8 +46,7 @@ nlohmann::json harmonics_json(const hbm::HarmonicLayout& layout, const Eigen::Ve
   nlohmann::json rows = nlohmann::json::array();
   const int m = layout.per_direction();
   rows.push_back({0, v[dir * m], 0.0});
-  for (int n = 1; n <= layout.n_harmonics(); ++n)
-    rows.push_back({n, v[dir * m + 2 * n - 1], v[dir * m + 2 * n]});
+  for (int n = 1; n <= layout.n_harmonics(); ++n) rows.push_back({n, v[dir * m + 2 * n - 1], v[dir * m + 2 * n]});
   return rows;
 }
 
@@ -76,9 +75,10 @@ int cmd_contact(Context& ctx) {
   const int h = c.hbm.harmonics;
   const int n = c.hbm.time_samples;
   if (model == contact::Model::one_d_exact && h != 1)
-    refuse(c, "hbm.harmonics", "= " + std::to_string(h) +
-                                   " violates: harmonics = 1 for contact.model = \"1d_exact\" "
-                                   "(the time-continuous single-harmonic law)");
+    refuse(c, "hbm.harmonics",
+           "= " + std::to_string(h) +
+               " violates: harmonics = 1 for contact.model = \"1d_exact\" "
+               "(the time-continuous single-harmonic law)");
 
   contact::PairParameters pair;
   pair.tangential_stiffness = c.contact.tangential_stiffness;
@@ -118,10 +118,12 @@ int cmd_contact(Context& ctx) {
       if (!std::isfinite(row.cosine) || !std::isfinite(row.sine))
         refuse(c, names[d], "row for harmonic " + std::to_string(row.harmonic) + " violates: finite amplitudes");
       if (row.harmonic < 0 || row.harmonic > h)
-        refuse(c, names[d], "harmonic " + std::to_string(row.harmonic) + " violates: 0 <= harmonic <= hbm.harmonics (= " +
-                                std::to_string(h) + ")");
+        refuse(c, names[d],
+               "harmonic " + std::to_string(row.harmonic) +
+                   " violates: 0 <= harmonic <= hbm.harmonics (= " + std::to_string(h) + ")");
       if (row.harmonic == 0 && row.sine != 0.0)
-        refuse(c, names[d], "harmonic 0 sine = " + std::to_string(row.sine) + " violates: 0 (the mean has no sine part)");
+        refuse(c, names[d],
+               "harmonic 0 sine = " + std::to_string(row.sine) + " violates: 0 (the mean has no sine part)");
       w_in[d * m + hbm::HarmonicLayout::local_index(row.harmonic, hbm::HarmonicLayout::Part::cosine)] += row.cosine;
       if (row.harmonic > 0)
         w_in[d * m + hbm::HarmonicLayout::local_index(row.harmonic, hbm::HarmonicLayout::Part::sine)] += row.sine;
@@ -157,8 +159,7 @@ int cmd_contact(Context& ctx) {
       (detail.jacobian - jac_other[0]).norm() / std::max(jac_other[0].norm(), std::numeric_limits<double>::min());
   const double energy = hbm::dissipated_energy(layout, w, detail.force);
 
-  if (!detail.force.allFinite() || !detail.jacobian.allFinite() || !detail.f.allFinite() ||
-      !std::isfinite(energy))
+  if (!detail.force.allFinite() || !detail.jacobian.allFinite() || !detail.f.allFinite() || !std::isfinite(energy))
     throw NumericalError("contact: the evaluation produced a non-finite value");
   if (!detail.status.converged)
     ctx.report.warn("contact: the damper state did not repeat within " + std::to_string(options.law.max_periods) +
@@ -172,8 +173,7 @@ int cmd_contact(Context& ctx) {
   j["harmonics"] = h;
   j["time_samples"] = model == contact::Model::one_d_exact ? static_cast<int>(detail.w.rows()) : n;
   j["omega_rad_s"] = 2.0 * kPi;
-  j["omega_note"] =
-      "the discrete contact map depends only on the phase: evaluated at w = 2 pi rad/s (period 1 s)";
+  j["omega_note"] = "the discrete contact map depends only on the phase: evaluated at w = 2 pi rad/s (period 1 s)";
   j["frame"] = "pair frame (t1, t2, n) turned by contact.frame_angle_deg; x, y tangential, z normal (> 0 presses)";
   j["pair"] = {{"tangential_stiffness_n_m", pair.tangential_stiffness},
                {"normal_stiffness_n_m", pair.normal_stiffness},
@@ -192,8 +192,12 @@ int cmd_contact(Context& ctx) {
   Eigen::MatrixX3d fh = detail.f;
   if (dirs == 1) fh.col(2).setConstant(pair.normal_preload);  // 1d: constant normal load
   j["time"] = {{"t_s", t},
-               {"x", column(detail.w, 0)},  {"y", column(detail.w, 1)},  {"z", column(detail.w, 2)},
-               {"tx", column(fh, 0)},       {"ty", column(fh, 1)},       {"n", column(fh, 2)}};
+               {"x", column(detail.w, 0)},
+               {"y", column(detail.w, 1)},
+               {"z", column(detail.w, 2)},
+               {"tx", column(fh, 0)},
+               {"ty", column(fh, 1)},
+               {"n", column(fh, 2)}};
   nlohmann::json rows = nlohmann::json::array();
   for (Eigen::Index r = 0; r < detail.jacobian.rows(); ++r) {
     std::vector<double> row(static_cast<size_t>(detail.jacobian.cols()));
@@ -217,8 +221,8 @@ int cmd_contact(Context& ctx) {
   ctx.report.stage("contact", total.seconds());
   log::info("contact: " + contact::to_string(model) + "/" + contact::to_string(update) + ", H = " + std::to_string(h) +
             ", N = " + std::to_string(n) + ", " + std::to_string(detail.status.periods) + " periods" +
-            (detail.status.converged ? "" : " (not converged)") + ", dissipated " + sci(energy) +
-            " J/cycle -> " + (ctx.out_dir / "contact.json").string());
+            (detail.status.converged ? "" : " (not converged)") + ", dissipated " + sci(energy) + " J/cycle -> " +
+            (ctx.out_dir / "contact.json").string());
   draw_plots(ctx);
   return 0;
 }

@@ -3,16 +3,15 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <iomanip>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
 #include <sstream>
 
 #include "app/context.hpp"
 #include "app/forced_stage.hpp"
-#include "study/curves.hpp"
 #include "app/modal_stage.hpp"
 #include "continuation/arclength.hpp"
 #include "core/error.hpp"
@@ -22,6 +21,7 @@
 #include "frf/lumped.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "io/output.hpp"
+#include "study/curves.hpp"
 
 namespace shroudsim::app {
 namespace {
@@ -105,7 +105,8 @@ int frf_auto(Context& ctx) {
   const forced::DiscretizationTrial& chosen = search.trials[search.chosen];
   const std::filesystem::path& chosen_dir = dirs[search.chosen];
   for (const char* f : {"frf.csv", "loops.csv", "peaks.csv"})
-    if (std::filesystem::exists(chosen_dir / f)) io::write_file_atomic(ctx.out_dir / f, study::read_file(chosen_dir / f));
+    if (std::filesystem::exists(chosen_dir / f))
+      io::write_file_atomic(ctx.out_dir / f, study::read_file(chosen_dir / f));
   ctx.frf_curve = chosen.curve;
   ctx.report.section("frf") = frf_sections[search.chosen];
   const double tol = settings.tolerance;
@@ -118,21 +119,27 @@ int frf_auto(Context& ctx) {
   a["time_samples_converged"] = search.time_samples_converged;
   a["trials"] = nlohmann::json::array();
   for (const auto& t : search.trials)
-    a["trials"].push_back({{"harmonics", t.harmonics}, {"time_samples", t.time_samples},
-                          {"status", t.ok ? "ok" : "numerics_failed"}, {"peak_amplitude_m", t.peak_amplitude_m},
-                          {"peak_frequency_hz", t.peak_frequency_hz}, {"seconds", t.seconds},
-                          {"relative_change", t.relative_change >= 0 ? nlohmann::json(t.relative_change) : nlohmann::json(nullptr)}});
+    a["trials"].push_back(
+        {{"harmonics", t.harmonics},
+         {"time_samples", t.time_samples},
+         {"status", t.ok ? "ok" : "numerics_failed"},
+         {"peak_amplitude_m", t.peak_amplitude_m},
+         {"peak_frequency_hz", t.peak_frequency_hz},
+         {"seconds", t.seconds},
+         {"relative_change", t.relative_change >= 0 ? nlohmann::json(t.relative_change) : nlohmann::json(nullptr)}});
   ctx.report.stage("frf", clock.seconds());
   log::info("frf: auto chose H = " + std::to_string(h) + ", N = " + std::to_string(n) + " (" +
             std::to_string(search.trials.size()) + " trials)");
   if (!search.harmonics_converged)
     ctx.report.warn("hbm.harmonics = \"auto\": the peak still changed by more than " + io::format_number(tol) +
-                    " at H = " + std::to_string(h) + " (hbm.auto_max_harmonics or the fixed time_samples stopped the search)");
+                    " at H = " + std::to_string(h) +
+                    " (hbm.auto_max_harmonics or the fixed time_samples stopped the search)");
   if (!search.time_samples_converged)
     ctx.report.warn("hbm.time_samples = \"auto\": the peak still changed by more than " + io::format_number(tol) +
                     " at N = " + std::to_string(n) + " (hbm.auto_max_time_samples)");
   draw_plots(ctx);
-  if (!chosen.ok) throw NumericalError("with H = " + std::to_string(h) + ", N = " + std::to_string(n) + ": " + chosen.message);
+  if (!chosen.ok)
+    throw NumericalError("with H = " + std::to_string(h) + ", N = " + std::to_string(n) + ": " + chosen.message);
   return 0;
 }
 
@@ -150,9 +157,11 @@ ForcedModel make_lumped_model(const io::Case& c) {
     model.pairs.push_back(pair_of(c.contact, &e));
   }
   if (contacts.empty())
-    throw InputError(c.locations.at("contact.elements") + ": contact.elements: a lumped forced response needs at least one [[contact.elements]]");
+    throw InputError(c.locations.at("contact.elements") +
+                     ": contact.elements: a lumped forced response needs at least one [[contact.elements]]");
   model.linear = std::make_unique<frf::LumpedLinearPart>(c.structure.mass, c.structure.stiffness, c.structure.damping,
-                                                         contacts, c.excitation.dof, c.excitation.force[0], c.response.dof);
+                                                         contacts, c.excitation.dof, c.excitation.force[0],
+                                                         c.response.dof);
   return model;
 }
 
@@ -168,8 +177,9 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
   // nonsmooth contact states) would change from run to run: estimated plans are reproducible.
   o.measure_plans = false;
   if (o.law.model == contact::Model::one_d_exact && o.n_harmonics != 1)
-    throw InputError(c.locations.at("hbm.harmonics") + ": hbm.harmonics = " + std::to_string(c.hbm.harmonics) +
-                     " violates: harmonics = 1 for contact.model = \"1d_exact\" (the time-continuous single-harmonic law)");
+    throw InputError(
+        c.locations.at("hbm.harmonics") + ": hbm.harmonics = " + std::to_string(c.hbm.harmonics) +
+        " violates: harmonics = 1 for contact.model = \"1d_exact\" (the time-continuous single-harmonic law)");
   std::vector<std::string> errors;
   if (!o.validate(&errors)) {
     throw InputError(c.where("hbm.time_samples") + ": hbm: " + errors.front());
@@ -190,7 +200,8 @@ forced::FrequencyResponseSettings frequency_response_settings(const io::Case& c)
 int cmd_frf(Context& ctx) {
   const io::Case& c = ctx.config;
   if (c.excitation.force[0] == 0.0 && c.excitation.force[1] == 0.0 && c.excitation.force[2] == 0.0) {
-    throw InputError(c.where("excitation.force") + ": excitation.force is zero: the forced response is the trivial zero solution (nothing to trace)");
+    throw InputError(c.where("excitation.force") +
+                     ": excitation.force is zero: the forced response is the trivial zero solution (nothing to trace)");
   }
   if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return frf_auto(ctx);
   log::Stopwatch clock;
@@ -307,7 +318,9 @@ int cmd_frf(Context& ctx) {
   }
   j["peaks"] = nlohmann::json::array();
   for (const auto& pk : response.peaks)
-    j["peaks"].push_back({{"frequency_hz", pk.frequency_hz}, {"amplitude_m", pk.amplitude_m}, {"located", pk.located},
+    j["peaks"].push_back({{"frequency_hz", pk.frequency_hz},
+                          {"amplitude_m", pk.amplitude_m},
+                          {"located", pk.located},
                           {"piece", pk.piece}});
   j["peak_location_seconds"] = response.peak_seconds;
   j["max_energy_balance_error"] = max_energy_error;
@@ -330,7 +343,8 @@ int cmd_frf(Context& ctx) {
                  {"solve_seconds", st.solve_seconds}};
   ctx.report.stage("frf", clock.seconds());
   if (unconverged > 0)
-    ctx.report.warn(std::to_string(unconverged) + " contact evaluations did not reach a periodic state within the period cap");
+    ctx.report.warn(std::to_string(unconverged) +
+                    " contact evaluations did not reach a periodic state within the period cap");
   // A point whose excitation work and dissipation disagree is not a solution of the
   // mechanics, whatever the residual says (e.g. a contact law that did not reach its periodic
   // state): the run fails its own check (docs/continuation.md).
@@ -350,8 +364,8 @@ int cmd_frf(Context& ctx) {
   if (energy_failed && branch.status == continuation::BranchStatus::kReachedEnd) {
     ctx.report.section("frf")["failed"] = true;
     throw NumericalError("the energy balance fails its check: error " + io::format_number(max_energy_error) + " at " +
-                         io::format_number(worst_energy_f) + " Hz exceeds hbm.energy_tolerance = " +
-                         io::format_number(c.hbm.energy_tolerance) +
+                         io::format_number(worst_energy_f) +
+                         " Hz exceeds hbm.energy_tolerance = " + io::format_number(c.hbm.energy_tolerance) +
                          " (excitation work and dissipation per cycle disagree: raise hbm.time_samples, or relax "
                          "hbm.energy_tolerance to accept the curve; " +
                          std::to_string(results.size()) + " points written to frf.csv)");

@@ -9,23 +9,23 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iomanip>
 #include <mutex>
 #include <numbers>
-#include <iomanip>
 #include <sstream>
 #include <thread>
 
-#include "core/format.hpp"
 #include "app/context.hpp"
 #include "app/modal_stage.hpp"
-#include "linalg/parallel.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/log.hpp"
 #include "frf/contact_patches.hpp"
 #include "io/output.hpp"
 #include "io/vtu.hpp"
-#include "modal/modal_stage.hpp"
+#include "linalg/parallel.hpp"
 #include "modal/harmonic.hpp"
+#include "modal/modal_stage.hpp"
 #include "modal/rotating.hpp"
 
 #ifndef SHROUDSIM_SOURCE_DIR
@@ -36,8 +36,6 @@ namespace shroudsim::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-
 
 }  // namespace
 
@@ -83,8 +81,8 @@ std::vector<int> modal_harmonic_indices(const io::Case& c) {
   }
   for (int h : c.modal.harmonic_indices) {
     if (h < 0 || h >= nb)
-      throw InputError(c.where("modal.harmonic_indices") + ": modal.harmonic_indices contains " +
-                       std::to_string(h) + ", which violates: 0 <= h < structure.sectors = " + std::to_string(nb));
+      throw InputError(c.where("modal.harmonic_indices") + ": modal.harmonic_indices contains " + std::to_string(h) +
+                       ", which violates: 0 <= h < structure.sectors = " + std::to_string(nb));
     hs.push_back(h);
   }
   std::sort(hs.begin(), hs.end());
@@ -92,8 +90,8 @@ std::vector<int> modal_harmonic_indices(const io::Case& c) {
   return hs;
 }
 
-ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors,
-                           double speed_rpm, Shroud shroud) {
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors, double speed_rpm,
+                           Shroud shroud) {
   const io::Case& c = ctx.config;
   ModalModel model;
   model.mesh = obtain_mesh(ctx);
@@ -122,8 +120,11 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
   const double km_seconds = matrices.seconds;
   log::Stopwatch clock;
   ctx.report.stage("assembly", km_seconds, km_reused);
-  report["matrices"] = {{"key", km_key}, {"reused", km_reused}, {"seconds", km_seconds},
-                        {"dofs", model.mesh.n_dofs()}, {"stored_entries_K", model.km.K.nonZeros()}};
+  report["matrices"] = {{"key", km_key},
+                        {"reused", km_reused},
+                        {"seconds", km_seconds},
+                        {"dofs", model.mesh.n_dofs()},
+                        {"stored_entries_K", model.km.K.nonZeros()}};
   log::info(std::string(km_reused ? "reused" : "assembled") + " K and M: " + std::to_string(model.mesh.n_dofs()) +
             " DOFs, " + std::to_string(model.km.K.nonZeros()) + " stored entries (" + fixed(km_seconds, 2) + " s)");
 
@@ -138,15 +139,15 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     std::vector<cyclic::InterfaceSpring> closed;
     for (std::size_t i = 0; i < st.results.size(); ++i)
       if (st.results[i].state != contact::StaticState::open) closed.push_back(st.springs[i]);
-    report["shroud_contact_at_rest"] = {{"closed", closed.size()}, {"open", st.results.size() - closed.size()},
-                                        {"normal_load_n", st.normal_load()}};
+    report["shroud_contact_at_rest"] = {
+        {"closed", closed.size()}, {"open", st.results.size() - closed.size()}, {"normal_load_n", st.normal_load()}};
     model.interface = std::move(closed);
   }
   if (shroud != Shroud::open) {
     double kn = 0.0, kt = 0.0;
     for (const auto& sp : model.interface) kt += sp.stiffness[0], kn += sp.stiffness[2];
-    report["shroud_springs"] = {{"pairs", model.interface.size()}, {"normal_stiffness_n_per_m", kn},
-                                {"tangential_stiffness_n_per_m", kt}};
+    report["shroud_springs"] = {
+        {"pairs", model.interface.size()}, {"normal_stiffness_n_per_m", kn}, {"tangential_stiffness_n_per_m", kt}};
     std::ostringstream line;
     line << "shroud " << report["shroud"].get<std::string>() << ": " << model.interface.size()
          << " matched shroud pairs tied (kn " << std::setprecision(6) << kn << " N/m, kt " << kt << " N/m)";
@@ -165,7 +166,8 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     model.km.K.makeCompressed();
     const double seconds = clock.seconds();
     ctx.report.stage("prestress", seconds, false);
-    report["rotating"] = {{"speed_rpm", speed_rpm}, {"omega_rad_s", omega},
+    report["rotating"] = {{"speed_rpm", speed_rpm},
+                          {"omega_rad_s", omega},
                           {"peak_von_mises_pa", ops.peak.von_mises * omega * omega},
                           {"max_static_displacement_m", ops.displacement.cwiseAbs().maxCoeff() * omega * omega},
                           {"seconds", seconds}};
@@ -193,16 +195,24 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
     modal::CachedModes& o = outcome.at(h);
     const auto& r = o.result.report;
     all_reused = all_reused && o.reused;
-    nlohmann::json entry = {{"harmonic_index", h}, {"nodal_diameter", cyclic::nodal_diameter(h, nb)},
-                            {"reused", o.reused}, {"status", modal::to_string(r.status)},
+    nlohmann::json entry = {{"harmonic_index", h},
+                            {"nodal_diameter", cyclic::nodal_diameter(h, nb)},
+                            {"reused", o.reused},
+                            {"status", modal::to_string(r.status)},
                             {"modes", o.result.basis.size()}};
     if (!o.reused) {
-      entry.update({{"message", r.message}, {"method", r.method}, {"spectra_info", r.spectra_info},
+      entry.update({{"message", r.message},
+                    {"method", r.method},
+                    {"spectra_info", r.spectra_info},
                     {"requested_eigenvalues", r.requested_eigenvalues},
-                    {"converged_eigenvalues", r.converged_eigenvalues}, {"restarts", r.iterations},
-                    {"solves", r.operations}, {"mass_products", r.mass_products},
-                    {"max_relative_residual", r.max_residual}, {"factor_nonzeros", r.factor_nonzeros},
-                    {"factor_seconds", r.factor_seconds}, {"lanczos_seconds", r.solve_seconds},
+                    {"converged_eigenvalues", r.converged_eigenvalues},
+                    {"restarts", r.iterations},
+                    {"solves", r.operations},
+                    {"mass_products", r.mass_products},
+                    {"max_relative_residual", r.max_residual},
+                    {"factor_nonzeros", r.factor_nonzeros},
+                    {"factor_seconds", r.factor_seconds},
+                    {"lanczos_seconds", r.solve_seconds},
                     {"seconds", o.seconds}});
     }
     per_h.push_back(entry);
@@ -237,7 +247,8 @@ void write_modes_csv(Context& ctx, const ModalModel& model) {
   for (const auto& [h, b] : model.bases) {
     const Eigen::VectorXd f = b.frequency_hz();
     for (int r = 0; r < b.size(); ++r)
-      s << h << ',' << cyclic::nodal_diameter(h, model.mesh.sectors) << ',' << r + 1 << ',' << io::format_number(f(r)) << '\n';
+      s << h << ',' << cyclic::nodal_diameter(h, model.mesh.sectors) << ',' << r + 1 << ',' << io::format_number(f(r))
+        << '\n';
   }
   io::write_file_atomic(ctx.out_dir / "modes.csv", s.str());
 }
@@ -263,7 +274,8 @@ void write_modes_vtu(Context& ctx, ModalModel& model) {
     for (int r = 0; r < n; ++r) {
       Eigen::Index imax = 0;
       full.col(r).cwiseAbs().maxCoeff(&imax);
-      const std::complex<double> turn = std::abs(full(imax, r)) > 0 ? std::conj(full(imax, r)) / std::abs(full(imax, r)) : 1.0;
+      const std::complex<double> turn = std::abs(full(imax, r)) > 0 ? std::conj(full(imax, r)) / std::abs(full(imax, r))
+                                                                    : 1.0;
       const Eigen::VectorXd re = (full.col(r) * turn).real();
       const double scale = re.cwiseAbs().maxCoeff() > 0 ? 1.0 / re.cwiseAbs().maxCoeff() : 1.0;
       std::vector<float> v(re.size());

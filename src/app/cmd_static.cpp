@@ -54,7 +54,8 @@ int cmd_static(Context& ctx) {
   std::ostringstream csv;
   csv << "pair,high_node,low_node,x_m,y_m,z_m,area_m2,state,gap_m,normal_load_n,tangential_load_n,pressure_pa\n";
   double tangential = 0.0, max_gap = 0.0, max_pressure = 0.0;
-  Eigen::MatrixXd pressure = Eigen::MatrixXd::Zero(m.n_nodes(), 1), state = Eigen::MatrixXd::Constant(m.n_nodes(), 1, -1.0);
+  Eigen::MatrixXd pressure = Eigen::MatrixXd::Zero(m.n_nodes(), 1),
+                  state = Eigen::MatrixXd::Constant(m.n_nodes(), 1, -1.0);
   for (std::size_t i = 0; i < st.face.size(); ++i) {
     const auto& f = st.face[i];
     const auto& r = st.results[i];
@@ -64,8 +65,8 @@ int cmd_static(Context& ctx) {
     max_pressure = std::max(max_pressure, p);
     csv << i << ',' << f.high << ',' << f.low;
     for (int k = 0; k < 3; ++k) csv << ',' << io::format_number(m.nodes(f.high, k));
-    csv << ',' << io::format_number(f.area) << ',' << contact::to_string(r.state) << ',' << io::format_number(r.gap) << ','
-        << io::format_number(r.force[2]) << ',' << io::format_number(t) << ',' << io::format_number(p) << '\n';
+    csv << ',' << io::format_number(f.area) << ',' << contact::to_string(r.state) << ',' << io::format_number(r.gap)
+        << ',' << io::format_number(r.force[2]) << ',' << io::format_number(t) << ',' << io::format_number(p) << '\n';
     for (int node : {f.high, f.low}) {
       pressure(node, 0) = p;
       state(node, 0) = static_cast<double>(r.state);
@@ -78,8 +79,10 @@ int cmd_static(Context& ctx) {
   const Eigen::VectorXd vm = fe::nodal_von_mises(m, model.material, st.displacement);
   const fe::PeakStress peak = fe::peak_von_mises(m, model.material, st.displacement);
   io::write_point_fields_vtu(ctx.out_dir / "contact_static.vtu", m,
-                         {{"displacement_m", disp}, {"von_mises_pa", Eigen::MatrixXd(vm)},
-                          {"contact_pressure_pa", pressure}, {"contact_state", state}});
+                             {{"displacement_m", disp},
+                              {"von_mises_pa", Eigen::MatrixXd(vm)},
+                              {"contact_pressure_pa", pressure},
+                              {"contact_state", state}});
 
   const int open = st.count(contact::StaticState::open), stick = st.count(contact::StaticState::stick),
             slip = st.count(contact::StaticState::slip);
@@ -102,10 +105,10 @@ int cmd_static(Context& ctx) {
        {"seconds", st.seconds}};
   ctx.report.stage("static", clock.seconds());
   std::ostringstream s;
-  s << "static: " << speed << " rpm, interference " << c.contact.interference << " m: " << st.face.size()
-    << " pairs, " << open << " open, " << stick << " stick, " << slip << " slip; normal load " << std::setprecision(4)
-    << st.normal_load() << " N, tangential " << tangential << " N; peak von Mises " << peak.von_mises / 1e6
-    << " MPa (" << st.increments << " increments, " << st.newton_iterations << " Newton iterations, " << std::setprecision(3)
+  s << "static: " << speed << " rpm, interference " << c.contact.interference << " m: " << st.face.size() << " pairs, "
+    << open << " open, " << stick << " stick, " << slip << " slip; normal load " << std::setprecision(4)
+    << st.normal_load() << " N, tangential " << tangential << " N; peak von Mises " << peak.von_mises / 1e6 << " MPa ("
+    << st.increments << " increments, " << st.newton_iterations << " Newton iterations, " << std::setprecision(3)
     << st.seconds << " s)";
   log::info(s.str());
   draw_plots(ctx);

@@ -6,8 +6,8 @@
 // `study --convergence CASE` instead measures the accuracy/speed trade of the case's knobs
 // (run_convergence below) -> trade.csv, trade.png; it needs no [study] section.
 #include <algorithm>
-#include <cmath>
 #include <atomic>
+#include <cmath>
 #include <ctime>
 #include <iomanip>
 #include <iostream>
@@ -18,13 +18,13 @@
 #include <thread>
 
 #include "app/context.hpp"
-#include "study/curves.hpp"
-#include "study/trade_design.hpp"
 #include "app/modal_stage.hpp"
-#include "linalg/parallel.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
+#include "linalg/parallel.hpp"
+#include "study/curves.hpp"
+#include "study/trade_design.hpp"
 
 namespace shroudsim::app {
 namespace {
@@ -119,7 +119,6 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
   return workers;
 }
 
-
 /// `study --convergence`: every knob of the accuracy/speed trade varied one at a time around
 /// the case's own setting, each against its finest value (the reference), with every other
 /// knob at the case's setting. The error of a point is peaks_change (study/curves.hpp) between
@@ -130,8 +129,7 @@ int run_convergence(Context& ctx) {
   const io::Case& c = ctx.config;
   auto num = [](double v) { return io::format_number(v); };
   const std::vector<study::Knob> knobs = study::convergence_knobs(c);
-  if (knobs.empty())
-    throw InputError(c.file.string() + ": study --convergence: this case has no knob to vary");
+  if (knobs.empty()) throw InputError(c.file.string() + ": study --convergence: this case has no knob to vary");
 
   // Points: one per distinct set of overrides (the case itself appears under several knobs).
   std::vector<StudyPoint> points;
@@ -186,7 +184,8 @@ int run_convergence(Context& ctx) {
     for (const auto& [k, v] : p.values) sets.push_back(k + "=" + v);
     cases.push_back(io::load_case(c.file, sets));
   }
-  log::info("study --convergence: " + std::to_string(knobs.size()) + " knobs, " + std::to_string(points.size()) + " runs");
+  log::info("study --convergence: " + std::to_string(knobs.size()) + " knobs, " + std::to_string(points.size()) +
+            " runs");
   log::Stopwatch clock;
   const int workers = run_points(ctx, cases, points);
   ctx.report.stage("study", clock.seconds());
@@ -201,7 +200,8 @@ int run_convergence(Context& ctx) {
     const bool ok = p.status == 0 && r.status == 0;
     double err = 0.0, ferr = 0.0;
     if (ok) {
-      const auto cp = study::read_curve(ctx.out_dir / p.folder / "frf.csv"), cr = study::read_curve(ctx.out_dir / r.folder / "frf.csv");
+      const auto cp = study::read_curve(ctx.out_dir / p.folder / "frf.csv"),
+                 cr = study::read_curve(ctx.out_dir / r.folder / "frf.csv");
       err = study::peaks_change(cp, cr);
       ferr = study::peaks_shift_hz(cp, cr);
     }
@@ -209,12 +209,16 @@ int run_convergence(Context& ctx) {
     for (std::string* t : {&value, &ref}) t->erase(std::remove(t->begin(), t->end(), '"'), t->end());
     csv << knobs[row.knob].name << "," << knobs[row.knob].key << "," << value << "," << ref << ","
         << (p.status == 0 ? "ok" : "failed") << "," << num(p.seconds) << "," << p.points << "," << num(p.peak) << ","
-        << num(p.peak_frequency) << "," << (ok ? num(err) : "") << "," << (ok ? num(ferr) : "") << "," << p.folder << "," << num(p.cpu_seconds) << "\n";
+        << num(p.peak_frequency) << "," << (ok ? num(err) : "") << "," << (ok ? num(ferr) : "") << "," << p.folder
+        << "," << num(p.cpu_seconds) << "\n";
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());
-  ctx.report.section("study") = {{"convergence", true}, {"runs", points.size()}, {"knobs", knobs.size()},
-                                 {"failed_rows", failed}, {"workers", workers}};
+  ctx.report.section("study") = {{"convergence", true},
+                                 {"runs", points.size()},
+                                 {"knobs", knobs.size()},
+                                 {"failed_rows", failed},
+                                 {"workers", workers}};
   // The mesh ladder: observed order and extrapolated peak (docs/contact_patches.md).
   for (std::size_t k = 0; k < knobs.size(); ++k) {
     if (knobs[k].key != "geometry.mesh_size") continue;
@@ -228,8 +232,11 @@ int run_convergence(Context& ctx) {
       }
     if (!all_ok || peaks.size() < 3) continue;
     const study::MeshConvergence mc = study::mesh_convergence(peaks, study::kMeshRatio);
-    nlohmann::json j = {{"mesh_sizes_m", sizes}, {"peaks_m", peaks}, {"case_peak_m", peaks.front()},
-                        {"finest_peak_m", peaks.back()}, {"monotone", mc.monotone}};
+    nlohmann::json j = {{"mesh_sizes_m", sizes},
+                        {"peaks_m", peaks},
+                        {"case_peak_m", peaks.front()},
+                        {"finest_peak_m", peaks.back()},
+                        {"monotone", mc.monotone}};
     j["observed_order"] = mc.monotone ? nlohmann::json(mc.order) : nlohmann::json(nullptr);
     j["extrapolated_peak_m"] = mc.monotone ? nlohmann::json(mc.extrapolated) : nlohmann::json(nullptr);
     j["case_error_estimate"] = mc.case_error;
@@ -238,9 +245,9 @@ int run_convergence(Context& ctx) {
     s << "study --convergence: mesh: peak " << io::format_number(peaks.front()) << " m at the case's size, "
       << io::format_number(peaks.back()) << " m at the finest";
     if (mc.monotone)
-      s << "; observed order " << std::setprecision(3) << mc.order << ", extrapolated " << io::format_number(mc.extrapolated) << " m";
-    else
-      s << "; not monotone over the three finest sizes (no extrapolation)";
+      s << "; observed order " << std::setprecision(3) << mc.order << ", extrapolated "
+        << io::format_number(mc.extrapolated) << " m";
+    else s << "; not monotone over the three finest sizes (no extrapolation)";
     s << "; estimated mesh error of the case: " << std::setprecision(3) << 100.0 * mc.case_error << " %";
     log::info(s.str());
   }
@@ -320,7 +327,8 @@ int cmd_study(Context& ctx) {
   ctx.report.section("study") = {{"points", points.size()}, {"failed", failed}, {"workers", workers}};
   draw_plots(ctx);
   if (failed) {
-    ctx.report.warn(std::to_string(failed) + " of " + std::to_string(points.size()) + " study points failed (see study.csv)");
+    ctx.report.warn(std::to_string(failed) + " of " + std::to_string(points.size()) +
+                    " study points failed (see study.csv)");
     return 3;
   }
   return 0;

@@ -29,12 +29,12 @@ class RunReport {
 };
 
 struct Context {
-  io::Case config;                  ///< the case as run (after --set)
-  std::filesystem::path out_dir;    ///< result folder (created on demand)
-  int threads = 0;                  ///< 0: all cores
+  io::Case config;                     ///< the case as run (after --set)
+  std::filesystem::path out_dir;       ///< result folder (created on demand)
+  int threads = 0;                     ///< 0: all cores
   std::vector<std::string> overrides;  ///< the command line's --set KEY=VALUE, in order
-  bool plots = true;                ///< draw plots after a command (off for study points)
-  bool convergence = false;         ///< `study --convergence`: the accuracy/speed trade
+  bool plots = true;                   ///< draw plots after a command (off for study points)
+  bool convergence = false;            ///< `study --convergence`: the accuracy/speed trade
   /// (frequency [Hz], amplitude [m]) of the forced response cmd_frf traced (as in frf.csv).
   std::vector<std::pair<double, double>> frf_curve;
   RunReport report;

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "app/context.hpp"
-#include "continuation/arclength.hpp"
 #include "contact/contact_law.hpp"
+#include "continuation/arclength.hpp"
 #include "forced/frequency_response.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/linear_part.hpp"

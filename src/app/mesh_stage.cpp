@@ -44,15 +44,18 @@ void describe_mesh(Context& ctx, const mesh::Mesh& m, const fs::path& file, bool
   for (const auto& [name, nodes] : m.node_sets) j["node_sets"][name] = nodes.size();
   j["cyclic_pairs"] = m.cyclic_pairs.size();
   j["shroud_pairs"] = m.shroud_pairs.size();
-  j["quality"] = {{"min_mean_ratio", q.min_mean_ratio}, {"mean_mean_ratio", q.mean_mean_ratio},
-                  {"below_0_1", q.below_0_1}, {"min_jacobian_ratio", q.min_jacobian_ratio}};
+  j["quality"] = {{"min_mean_ratio", q.min_mean_ratio},
+                  {"mean_mean_ratio", q.mean_mean_ratio},
+                  {"below_0_1", q.below_0_1},
+                  {"min_jacobian_ratio", q.min_jacobian_ratio}};
   std::ostringstream s;
-  s << "mesh " << file.string() << ": " << m.n_nodes() << " nodes, " << m.n_elements() << " "
-    << m.nodes_per_element() << "-node tetrahedra, " << m.n_dofs() << " DOFs, "
-    << m.cyclic_pairs.size() << " cyclic and " << m.shroud_pairs.size() << " shroud node pairs";
+  s << "mesh " << file.string() << ": " << m.n_nodes() << " nodes, " << m.n_elements() << " " << m.nodes_per_element()
+    << "-node tetrahedra, " << m.n_dofs() << " DOFs, " << m.cyclic_pairs.size() << " cyclic and "
+    << m.shroud_pairs.size() << " shroud node pairs";
   log::info(s.str());
   log::info("mesh " + mesh::describe(q));
-  if (q.min_mean_ratio < 0.05) ctx.report.warn("poor element quality: min mean ratio " + std::to_string(q.min_mean_ratio));
+  if (q.min_mean_ratio < 0.05)
+    ctx.report.warn("poor element quality: min mean ratio " + std::to_string(q.min_mean_ratio));
 }
 
 }  // namespace
@@ -102,11 +105,11 @@ mesh::Mesh obtain_mesh(Context& ctx) {
     // Bounded work: gmsh's element count, estimated from the volume, before meshing.
     const double estimate = geometry.analytic_volume() / (kElementVolumeRatio * std::pow(geometry.mesh_size, 3));
     if (!(estimate <= c.geometry.max_elements))
-      throw InputError(c.locations.at("geometry.mesh_size") + ": geometry.mesh_size = " +
-                       io::format_number(geometry.mesh_size) + " would give about " + std::to_string(std::llround(estimate)) +
-                       " elements (volume " + io::format_number(geometry.analytic_volume()) +
-                       " m^3), above geometry.max_elements = " + io::format_number(c.geometry.max_elements) +
-                       "; raise geometry.max_elements to mesh it anyway");
+      throw InputError(c.locations.at("geometry.mesh_size") +
+                       ": geometry.mesh_size = " + io::format_number(geometry.mesh_size) + " would give about " +
+                       std::to_string(std::llround(estimate)) + " elements (volume " +
+                       io::format_number(geometry.analytic_volume()) + " m^3), above geometry.max_elements = " +
+                       io::format_number(c.geometry.max_elements) + "; raise geometry.max_elements to mesh it anyway");
     log::info("meshing the sector (gmsh, " + std::to_string(geometry.element_order == 2 ? 10 : 4) +
               "-node tetrahedra, mesh_size " + io::format_number(geometry.mesh_size) + " m)");
     fs::remove(key_file);

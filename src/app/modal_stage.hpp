@@ -32,11 +32,11 @@ struct ModalModel {
   mesh::Mesh mesh;
   fe::Material material;
   modal::ModalOptions options;
-  double speed_rpm = 0.0;                     ///< > 0: K below is the rotating stiffness at this speed
-  linalg::SparsePair<double> km;              ///< sector K [N/m], M [kg] on all 3 * n_nodes DOFs
-  std::map<int, modal::ModalBasis> bases;     ///< per harmonic index (reduced DOFs of that h)
+  double speed_rpm = 0.0;                         ///< > 0: K below is the rotating stiffness at this speed
+  linalg::SparsePair<double> km;                  ///< sector K [N/m], M [kg] on all 3 * n_nodes DOFs
+  std::map<int, modal::ModalBasis> bases;         ///< per harmonic index (reduced DOFs of that h)
   std::map<int, modal::StiffnessFactor> factors;  ///< K_h factors kept from the solves (h with shift 0)
-  std::vector<std::string> failures;          ///< harmonic indices whose modes failed (message each)
+  std::vector<std::string> failures;              ///< harmonic indices whose modes failed (message each)
   /// The stuck shroud's springs (empty: open shroud); every reduction of cyclic() has them.
   std::vector<cyclic::InterfaceSpring> interface;
 

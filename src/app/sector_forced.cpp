@@ -6,21 +6,21 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <numbers>
+#include <optional>
 #include <set>
-#include <tuple>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "app/forced_stage.hpp"
 #include "app/modal_stage.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "io/output.hpp"
 #include "frf/contact_patches.hpp"
 #include "frf/sector.hpp"
 #include "frf/static_shroud.hpp"
+#include "io/output.hpp"
 #include "modal/rotating.hpp"
 
 namespace shroudsim::app {
@@ -41,8 +41,8 @@ void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
   // More contact patches than the face has node pairs (one face pair per matched shroud
   // pair, frf::shroud_face).
   if (c.contact.pairs > static_cast<int>(mesh.shroud_pairs.size())) {
-    throw InputError(c.where("contact.pairs") + ": contact.pairs = " +
-                     std::to_string(c.contact.pairs) + " violates: pairs <= " + std::to_string(mesh.shroud_pairs.size()) +
+    throw InputError(c.where("contact.pairs") + ": contact.pairs = " + std::to_string(c.contact.pairs) +
+                     " violates: pairs <= " + std::to_string(mesh.shroud_pairs.size()) +
                      " (the matched shroud node pairs of this mesh), or \"all\"");
   }
   // A point whose nearest node is clamped, or that lies off the sector, would give a silent
@@ -59,8 +59,9 @@ void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
       throw InputError(where + ": " + key + ": the nearest node (" + std::to_string(node) +
                        ") is on the clamped hub: it does not move; give a point on the blade or shroud");
     if (distance > 0.1 * size)
-      throw InputError(where + ": " + key + " is " + io::format_number(distance) + " m from the nearest node of the sector (" +
-                       "model size " + io::format_number(size) + " m): give a point on the sector");
+      throw InputError(where + ": " + key + " is " + io::format_number(distance) +
+                       " m from the nearest node of the sector (" + "model size " + io::format_number(size) +
+                       " m): give a point on the sector");
   }
 }
 
@@ -78,7 +79,8 @@ ForcedModel make_sector_model(Context& ctx) {
     if (c.excitation.speed_rpm > 0.0)
       ops = std::make_unique<modal::RotatingOperators>(
           modal::rotating_operators(rest.mesh, rest.material, rest.km, rest.cyclic()));
-    static_state = frf::solve_static_shroud(rest.mesh, rest.km, ops.get(), static_shroud_settings(c, c.excitation.speed_rpm));
+    static_state =
+        frf::solve_static_shroud(rest.mesh, rest.km, ops.get(), static_shroud_settings(c, c.excitation.speed_rpm));
   }
   ModalModel modal = run_modal_stage(ctx, std::vector<int>(needed.begin(), needed.end()), /*keep_factors=*/true,
                                      c.excitation.speed_rpm);  // > 0: the modes at that speed
@@ -92,7 +94,7 @@ ForcedModel make_sector_model(Context& ctx) {
   std::vector<frf::ContactPatch> patches;
   try {
     patches = frf::partition_face(mesh, face, c.contact.pairs);  // 0: "all"
-  } catch (const std::invalid_argument& e) {  // more pairs than the face has
+  } catch (const std::invalid_argument& e) {                     // more pairs than the face has
     throw InputError(c.locations.at("contact.pairs") + ": contact." + e.what());
   }
   std::vector<frf::SectorContactPair> pairs =
@@ -140,9 +142,10 @@ ForcedModel make_sector_model(Context& ctx) {
   j["response_node"] = forcing.response_node;
   j["harmonic_indices"] = std::vector<int>(needed.begin(), needed.end());
   std::ostringstream s;
-  s << "frf: " << pairs.size() << (discretization == frf::ContactDiscretization::patches ? " contact patches over " : " of ")
-    << face.size() << " shroud node pairs, contact area " << total * 1e6
-    << " mm^2; excitation node " << forcing.excitation_node << ", response node " << forcing.response_node;
+  s << "frf: " << pairs.size()
+    << (discretization == frf::ContactDiscretization::patches ? " contact patches over " : " of ") << face.size()
+    << " shroud node pairs, contact area " << total * 1e6 << " mm^2; excitation node " << forcing.excitation_node
+    << ", response node " << forcing.response_node;
   log::info(s.str());
   return model;
 }

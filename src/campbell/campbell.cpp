@@ -1,5 +1,5 @@
-#include "core/format.hpp"
 #include "campbell/campbell.hpp"
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -67,8 +67,8 @@ HarmonicSweep sweep_harmonic(const cyclic::CyclicSector& sector, const cyclic::C
         continue;
       }
       if (states && i >= states->solved()) {
-        s.failure = "harmonic index " + std::to_string(h) + ": no static shroud contact state at " + number(rpm[i]) +
-                    " rpm";
+        s.failure =
+            "harmonic index " + std::to_string(h) + ": no static shroud contact state at " + number(rpm[i]) + " rpm";
         break;
       }
       log::Stopwatch solve_clock;

@@ -52,7 +52,7 @@ struct HarmonicSweep {
   double seconds = 0.0;            ///< solves only
   double factor_seconds = 0.0, lanczos_seconds = 0.0;
   int solves = 0;
-  int analyses = 0;                ///< symbolic analyses of K_h + Omega^2 D_h (1 when reused)
+  int analyses = 0;  ///< symbolic analyses of K_h + Omega^2 D_h (1 when reused)
 };
 
 /// The rotating sweep of harmonic index h: `sector` the cyclic reduction of {K, M} (its

@@ -150,7 +150,8 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
   branch.newton_iterations += it;
   Eigen::VectorXd t;
   if (!s.tangent(y, e_lambda, direction * e_lambda, t))
-    return finish(BranchStatus::kEvaluationFailed, "the tangent at the start point could not be computed (singular Jacobian)");
+    return finish(BranchStatus::kEvaluationFailed,
+                  "the tangent at the start point could not be computed (singular Jacobian)");
   push(y, t, it, 0.0, norm, PointKind::kRegular);
   emit(false);
 
@@ -225,7 +226,8 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
         const bool inside = direction * (lf - o.lambda_end) <= lambda_slack &&
                             direction * (lf - o.lambda_start) >= -lambda_slack - o.start_slack;
         if (inside) {
-          push(fold.y, fold.t, fold.newton_iterations, fold.s, 0.0, fold.smooth ? PointKind::kFold : PointKind::kCorner);
+          push(fold.y, fold.t, fold.newton_iterations, fold.s, 0.0,
+               fold.smooth ? PointKind::kFold : PointKind::kCorner);
           h = std::max(h - fold.s, 0.0);
           if (static_cast<int>(branch.points.size()) >= o.max_points) break;  // the fold took the last place
         }
@@ -261,8 +263,9 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
     push(y, t, it, h, rnorm, PointKind::kRegular);
 
     // Reflection at a corner: back to the last point before the turn and over the corner.
-    if (watch.observe(y, h, [&](std::size_t j) -> Eigen::VectorXd { return ys[j]; },
-                      [&](std::size_t j) { return branch.points[j].step; })) {
+    if (watch.observe(
+            y, h, [&](std::size_t j) -> Eigen::VectorXd { return ys[j]; },
+            [&](std::size_t j) { return branch.points[j].step; })) {
       const std::size_t k = watch.first() - 1;
       const Eigen::VectorXd y0 = ys[k], t0 = branch.points[k].tangent;
       Eigen::VectorXd yk, tk;

@@ -74,24 +74,24 @@ class ParametricResidual {
 struct ArclengthOptions {
   double lambda_start = 0.0;
   double lambda_end = 1.0;
-  Eigen::VectorXd x_scale;        ///< typical magnitude of each unknown (> 0); empty: 1
-  Eigen::VectorXd residual_scale; ///< typical magnitude of each residual; empty: x_scale
-  double lambda_scale = 1.0;      ///< unit of lambda in the arclength
-  double initial_step = 0.5;      ///< arclength, scaled units
-  double min_step = 1e-6;         ///< relative to initial_step: stop when the step falls below
-  double max_step = 20.0;         ///< relative to initial_step
+  Eigen::VectorXd x_scale;         ///< typical magnitude of each unknown (> 0); empty: 1
+  Eigen::VectorXd residual_scale;  ///< typical magnitude of each residual; empty: x_scale
+  double lambda_scale = 1.0;       ///< unit of lambda in the arclength
+  double initial_step = 0.5;       ///< arclength, scaled units
+  double min_step = 1e-6;          ///< relative to initial_step: stop when the step falls below
+  double max_step = 20.0;          ///< relative to initial_step
   /// Largest change of lambda per step, scaled units (0: none). The arclength step is cut so
   /// that |t_lambda| h stays below it: the frequency resolution is bounded where the branch
   /// moves along lambda, while where it moves in x (a resonance's phase turning) the step is
   /// bounded by max_step and the turn of the tangent only.
   double max_lambda_step = 0.0;
   int max_points = 5000;
-  double tolerance = 1e-8;        ///< on the scaled residual, infinity norm
+  double tolerance = 1e-8;  ///< on the scaled residual, infinity norm
   int max_newton_iterations = 15;
   int target_newton_iterations = 4;  ///< grow the step below, shrink above
-  double max_turn_deg = 30.0;     ///< largest angle between successive tangents (scaled)
-  double target_turn_deg = 20.0;  ///< step control aims at this turn per step (< max_turn_deg)
-  double kink_step = 1e-3;        ///< relative to initial_step: below, large turns are accepted
+  double max_turn_deg = 30.0;        ///< largest angle between successive tangents (scaled)
+  double target_turn_deg = 20.0;     ///< step control aims at this turn per step (< max_turn_deg)
+  double kink_step = 1e-3;           ///< relative to initial_step: below, large turns are accepted
   /// How far beyond lambda_start (against the direction of travel, in lambda units) the
   /// branch may go before it counts as having left the range (0: not at all).
   double start_slack = 0.0;
@@ -110,10 +110,10 @@ enum class PointKind {
 struct BranchPoint {
   Eigen::VectorXd x;
   double lambda = 0.0;
-  Eigen::VectorXd tangent;        ///< unit tangent (scaled variables), size n+1, lambda last
+  Eigen::VectorXd tangent;  ///< unit tangent (scaled variables), size n+1, lambda last
   int newton_iterations = 0;
-  double step = 0.0;              ///< arclength step that led here
-  double residual_norm = 0.0;     ///< scaled, infinity norm
+  double step = 0.0;           ///< arclength step that led here
+  double residual_norm = 0.0;  ///< scaled, infinity norm
   PointKind kind = PointKind::kRegular;
 };
 
@@ -125,14 +125,14 @@ const char* to_string(BranchStatus status);
 struct Branch {
   std::vector<BranchPoint> points;  ///< in continuation order
   BranchStatus status = BranchStatus::kReachedEnd;
-  std::string message;              ///< why it stopped, for users
-  int turning_points = 0;           ///< folds and corner reversals passed (located, in points)
-  int smooth_folds = 0;             ///< of those, true folds (t_lambda -> 0)
-  int newton_iterations = 0;        ///< total
-  int rejected_steps = 0;           ///< corrector failures that shrank the step
-  int rejected_turns = 0;           ///< of those, steps whose tangent turned too far (branch jumps)
-  int kinks_crossed = 0;            ///< corners of a nonsmooth branch passed along the other piece
-  int reflections_crossed = 0;      ///< "turning points" that were reflections at a corner, crossed
+  std::string message;          ///< why it stopped, for users
+  int turning_points = 0;       ///< folds and corner reversals passed (located, in points)
+  int smooth_folds = 0;         ///< of those, true folds (t_lambda -> 0)
+  int newton_iterations = 0;    ///< total
+  int rejected_steps = 0;       ///< corrector failures that shrank the step
+  int rejected_turns = 0;       ///< of those, steps whose tangent turned too far (branch jumps)
+  int kinks_crossed = 0;        ///< corners of a nonsmooth branch passed along the other piece
+  int reflections_crossed = 0;  ///< "turning points" that were reflections at a corner, crossed
   int residual_evaluations = 0;
 };
 

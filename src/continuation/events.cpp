@@ -21,7 +21,7 @@ bool locate_fold(ScaledSystem& s, const Eigen::VectorXd& y0, const Eigen::Vector
   // steps the sign change is taken as located (the corner's position is a sampling artefact).
   constexpr int kMaxIterations = 40;
   constexpr int kCornerIterations = 12;
-  constexpr double kSmoothTangent = 1e-6;  // |t_lambda| below: the fold itself
+  constexpr double kSmoothTangent = 1e-6;      // |t_lambda| below: the fold itself
   constexpr double kLambdaResolution = 1e-12;  // scaled lambda (a range spans ~100 units)
   fold.newton_iterations = 0;
   for (int it = 0; it < kMaxIterations; ++it) {
@@ -159,10 +159,12 @@ Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& op
     const double u = std::abs(d) >= tol1 ? x + d : x + (d > 0 ? tol1 : -tol1);
     const double fu = f(u);
     if (fu <= fx) {
-      if (u < x) b = x; else a = x;
+      if (u < x) b = x;
+      else a = x;
       v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
     } else {
-      if (u < x) a = u; else b = u;
+      if (u < x) a = u;
+      else b = u;
       if (fu <= fw || w == x) {
         v = w, fv = fw, w = u, fw = fu;
       } else if (fu <= fv || v == x || v == w) {

@@ -18,9 +18,9 @@
 namespace shroudsim::continuation {
 
 struct FoldLocation {
-  Eigen::VectorXd y, t;   ///< the located point and its tangent (scaled)
-  double s = 0.0;         ///< arclength from the start of the step
-  bool smooth = false;    ///< |t_lambda| -> 0 there (a true fold); false: a corner reversal
+  Eigen::VectorXd y, t;  ///< the located point and its tangent (scaled)
+  double s = 0.0;        ///< arclength from the start of the step
+  bool smooth = false;   ///< |t_lambda| -> 0 there (a true fold); false: a corner reversal
   int newton_iterations = 0;
 };
 

@@ -33,8 +33,7 @@ class ScaledSystem {
   /// Solves [Js; row^T] d = b with the linearization of the last evaluate() that gave one.
   bool solve(const Linearization& lin, const Eigen::VectorXd& row, const Eigen::VectorXd& b, Eigen::VectorXd& d);
   /// Unit tangent at y: [Js; row^T] t = e_{n+1}, oriented so that t . orient >= 0.
-  bool tangent(const Eigen::VectorXd& y, const Eigen::VectorXd& row, const Eigen::VectorXd& orient,
-               Eigen::VectorXd& t);
+  bool tangent(const Eigen::VectorXd& y, const Eigen::VectorXd& row, const Eigen::VectorXd& orient, Eigen::VectorXd& t);
 
  private:
   ParametricResidual& r_;

@@ -23,14 +23,13 @@ class NumericalError : public std::runtime_error {
 };
 
 namespace detail {
-[[noreturn]] void check_failed(const char* condition, const std::string& message, const char* file,
-                               int line);
+[[noreturn]] void check_failed(const char* condition, const std::string& message, const char* file, int line);
 }  // namespace detail
 
 }  // namespace shroudsim
 
-#define SHROUDSIM_CHECK(cond, msg)                                             \
-  do {                                                                         \
+#define SHROUDSIM_CHECK(cond, msg)                                                    \
+  do {                                                                                \
     if (!(cond)) ::shroudsim::detail::check_failed(#cond, (msg), __FILE__, __LINE__); \
   } while (false)
 

@@ -24,8 +24,7 @@ int nodal_diameter(int h, int sectors) {
 CyclicSector::CyclicSector(const mesh::Mesh& mesh, const linalg::SparsePair<double>& km)
     : sectors_(mesh.sectors), n_full_(mesh.n_dofs()) {
   SHROUDSIM_CHECK(sectors_ >= 1, "CyclicSector: mesh.sectors must be >= 1");
-  SHROUDSIM_CHECK(km.K.rows() == n_full_ && km.M.rows() == n_full_,
-                  "CyclicSector: matrices do not match the mesh");
+  SHROUDSIM_CHECK(km.K.rows() == n_full_ && km.M.rows() == n_full_, "CyclicSector: matrices do not match the mesh");
   const int n_nodes = mesh.n_nodes();
   const double alpha = 2.0 * std::numbers::pi / sectors_;
   const Eigen::Matrix3d R = rotation_z(alpha);
@@ -35,15 +34,14 @@ CyclicSector::CyclicSector(const mesh::Mesh& mesh, const linalg::SparsePair<doub
   constexpr double kMatchTol = 1e-6;  // relative to the mesh size; gmsh writes ~16 digits
   std::vector<int> high_partner(n_nodes, -1), low_partner(n_nodes, -1);
   for (const auto& [p, q] : mesh.cyclic_pairs) {
-    if (p < 0 || q < 0 || p >= n_nodes || q >= n_nodes || p == q || high_partner[p] >= 0 ||
-        low_partner[q] >= 0 || low_partner[p] >= 0 || high_partner[q] >= 0)
+    if (p < 0 || q < 0 || p >= n_nodes || q >= n_nodes || p == q || high_partner[p] >= 0 || low_partner[q] >= 0 ||
+        low_partner[p] >= 0 || high_partner[q] >= 0)
       throw InputError("mesh: cyclic pair (" + std::to_string(p) + ", " + std::to_string(q) +
                        ") is invalid or uses a node twice");
     const Eigen::Vector3d xp = mesh.nodes.row(p).transpose(), xq = mesh.nodes.row(q).transpose();
     if ((xq - R * xp).norm() > kMatchTol * size)
-      throw InputError("mesh: cyclic_high node " + std::to_string(q) +
-                       " is not cyclic_low node " + std::to_string(p) + " rotated by 360/" +
-                       std::to_string(sectors_) + " degrees about z");
+      throw InputError("mesh: cyclic_high node " + std::to_string(q) + " is not cyclic_low node " + std::to_string(p) +
+                       " rotated by 360/" + std::to_string(sectors_) + " degrees about z");
     high_partner[p] = q;
     low_partner[q] = p;
   }

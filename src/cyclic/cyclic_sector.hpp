@@ -98,7 +98,7 @@ class CyclicSector {
   int sectors_ = 1;
   Eigen::Index n_full_ = 0;
   std::vector<int> reduced_to_full_, clamped_dofs_;
-  linalg::SparseMatrixD P_, G_;        // n_full x n_reduced
+  linalg::SparseMatrixD P_, G_;  // n_full x n_reduced
   linalg::SparseMatrixD KA_, KB_, MA_, MB_;
   std::vector<InterfaceSpring> springs_;
   /// Y_h^H diag(k) Y_h on the reduced DOFs (empty matrix without springs).

@@ -110,10 +110,8 @@ linalg::SparsePair<double> Assembler::assemble(const Material& material, int thr
       kv = k_extra[t - 1].data();
       mv = m_extra[t - 1].data();
     }
-    if (mesh.nodes_per_element() == 4)
-      assemble_range<4>(material, begin, end, kv, mv, &bad[t]);
-    else
-      assemble_range<10>(material, begin, end, kv, mv, &bad[t]);
+    if (mesh.nodes_per_element() == 4) assemble_range<4>(material, begin, end, kv, mv, &bad[t]);
+    else assemble_range<10>(material, begin, end, kv, mv, &bad[t]);
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < n_threads; ++t) pool.emplace_back(run, t);

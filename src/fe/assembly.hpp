@@ -34,14 +34,14 @@ class Assembler {
 
  private:
   template <int NPE>
-  void assemble_range(const Material& material, int begin, int end, double* k_values,
-                      double* m_values, int* bad_element) const;
+  void assemble_range(const Material& material, int begin, int end, double* k_values, double* m_values,
+                      int* bad_element) const;
   int position(int row_node, int col_node) const;  // offset of node block within column
 
-  const mesh::Mesh* mesh_;                // not owned
-  std::vector<int> adjacency_offsets_;    // per node: start in adjacency_ (CSR, sorted)
-  std::vector<int> adjacency_;            // neighbour nodes (incl. self), sorted per node
-  linalg::SparseMatrixD pattern_;         // values zero
+  const mesh::Mesh* mesh_;              // not owned
+  std::vector<int> adjacency_offsets_;  // per node: start in adjacency_ (CSR, sorted)
+  std::vector<int> adjacency_;          // neighbour nodes (incl. self), sorted per node
+  linalg::SparseMatrixD pattern_;       // values zero
 };
 
 /// K and M of `mesh` in one call (see Assembler).

@@ -14,10 +14,8 @@ class Hasher {
  public:
   void add_bytes(const void* data, std::size_t size);
   template <typename T>
-    requires std::is_trivially_copyable_v<T>
-  void add(const T& value) {
-    add_bytes(&value, sizeof(T));
-  }
+  requires std::is_trivially_copyable_v<T>
+  void add(const T& value) { add_bytes(&value, sizeof(T)); }
   void add(const std::string& s) {
     add(s.size());
     add_bytes(s.data(), s.size());

@@ -7,9 +7,9 @@
 namespace shroudsim::fe {
 
 struct TetQuadrature {
-  int degree = 0;                                            ///< exact for polynomials up to this total degree
-  std::vector<Eigen::Vector3d> points;                       ///< reference coordinates (xi, eta, zeta)
-  std::vector<double> weights;                               ///< all positive, sum 1/6
+  int degree = 0;                       ///< exact for polynomials up to this total degree
+  std::vector<Eigen::Vector3d> points;  ///< reference coordinates (xi, eta, zeta)
+  std::vector<double> weights;          ///< all positive, sum 1/6
   int size() const { return static_cast<int>(points.size()); }
 };
 

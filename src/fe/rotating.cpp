@@ -153,11 +153,13 @@ bool tet_geometric_stiffness(const ElementNodes<NPE>& X, const Material& materia
 template <int NPE>
 bool tet_geometric_stiffness(const ElementNodes<NPE>& X, const Eigen::Matrix3d& sigma, ScalarElementMatrix<NPE>& g) {
   const Eigen::Matrix3d s = 0.5 * (sigma + sigma.transpose());
-  return geometric_kernel<NPE>(X, [&](const Eigen::Matrix<double, NPE, 3>&) { return s; }, g);
+  return geometric_kernel<NPE>(
+      X, [&](const Eigen::Matrix<double, NPE, 3>&) { return s; }, g);
 }
 
 Eigen::VectorXd centrifugal_load(const mesh::Mesh& mesh, const linalg::SparseMatrixD& M) {
-  SHROUDSIM_CHECK(M.rows() == mesh.n_dofs() && M.cols() == mesh.n_dofs(), "centrifugal_load: M does not match the mesh");
+  SHROUDSIM_CHECK(M.rows() == mesh.n_dofs() && M.cols() == mesh.n_dofs(),
+                  "centrifugal_load: M does not match the mesh");
   Eigen::VectorXd x = Eigen::VectorXd::Zero(mesh.n_dofs());
   for (int n = 0; n < mesh.n_nodes(); ++n) {
     x(3 * n) = mesh.nodes(n, 0);
@@ -183,10 +185,8 @@ linalg::SparseMatrixD geometric_stiffness(const mesh::Mesh& mesh, const Material
   linalg::SparseMatrixD Kg = pattern;
   Kg.makeCompressed();
   std::fill(Kg.valuePtr(), Kg.valuePtr() + Kg.nonZeros(), 0.0);
-  if (mesh.nodes_per_element() == 4)
-    assemble_geometric_range<4>(mesh, material, u, Kg);
-  else
-    assemble_geometric_range<10>(mesh, material, u, Kg);
+  if (mesh.nodes_per_element() == 4) assemble_geometric_range<4>(mesh, material, u, Kg);
+  else assemble_geometric_range<10>(mesh, material, u, Kg);
   return Kg;
 }
 
@@ -200,10 +200,11 @@ template <int NPE>
 Eigen::VectorXd nodal_range(const mesh::Mesh& mesh, const Material& material, const Eigen::VectorXd& u) {
   // Reference coordinates of the nodes (gmsh order: vertices, then edge midpoints).
   static const std::vector<Eigen::Matrix<double, NPE, 3>> node_dn = [] {
-    const double ref[10][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.5, 0, 0},
+    const double ref[10][3] = {{0, 0, 0},     {1, 0, 0},   {0, 1, 0},   {0, 0, 1},     {0.5, 0, 0},
                                {0.5, 0.5, 0}, {0, 0.5, 0}, {0, 0, 0.5}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
     std::vector<Eigen::Matrix<double, NPE, 3>> v;
-    for (int a = 0; a < NPE; ++a) v.push_back(TetShape<NPE>::gradients(Eigen::Vector3d(ref[a][0], ref[a][1], ref[a][2])));
+    for (int a = 0; a < NPE; ++a)
+      v.push_back(TetShape<NPE>::gradients(Eigen::Vector3d(ref[a][0], ref[a][1], ref[a][2])));
     return v;
   }();
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(mesh.n_nodes()), count = sum;
@@ -234,8 +235,8 @@ Eigen::VectorXd nodal_von_mises(const mesh::Mesh& mesh, const Material& material
 
 template bool tet_stress<4>(const ElementNodes<4>&, const Material&, const ElementVector<4>&, const Eigen::Vector3d&,
                             Eigen::Matrix3d&);
-template bool tet_stress<10>(const ElementNodes<10>&, const Material&, const ElementVector<10>&,
-                             const Eigen::Vector3d&, Eigen::Matrix3d&);
+template bool tet_stress<10>(const ElementNodes<10>&, const Material&, const ElementVector<10>&, const Eigen::Vector3d&,
+                             Eigen::Matrix3d&);
 template bool tet_geometric_stiffness<4>(const ElementNodes<4>&, const Material&, const ElementVector<4>&,
                                          ScalarElementMatrix<4>&);
 template bool tet_geometric_stiffness<10>(const ElementNodes<10>&, const Material&, const ElementVector<10>&,

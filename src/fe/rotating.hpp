@@ -93,7 +93,8 @@ extern template bool tet_geometric_stiffness<4>(const ElementNodes<4>&, const Ma
                                                 ScalarElementMatrix<4>&);
 extern template bool tet_geometric_stiffness<10>(const ElementNodes<10>&, const Material&, const ElementVector<10>&,
                                                  ScalarElementMatrix<10>&);
-extern template bool tet_geometric_stiffness<4>(const ElementNodes<4>&, const Eigen::Matrix3d&, ScalarElementMatrix<4>&);
+extern template bool tet_geometric_stiffness<4>(const ElementNodes<4>&, const Eigen::Matrix3d&,
+                                                ScalarElementMatrix<4>&);
 extern template bool tet_geometric_stiffness<10>(const ElementNodes<10>&, const Eigen::Matrix3d&,
                                                  ScalarElementMatrix<10>&);
 

@@ -26,8 +26,8 @@ struct Grid {
 };
 
 struct Tet4Mesh {
-  mesh::Mesh mesh;                 // 4-node
-  std::vector<Ijk> grid_index;     // per node: its grid vertex
+  mesh::Mesh mesh;              // 4-node
+  std::vector<Ijk> grid_index;  // per node: its grid vertex
 };
 
 Tet4Mesh build_tet4(const Grid& g) {
@@ -131,8 +131,8 @@ void make_quadratic(mesh::Mesh& m) {
 
 }  // namespace
 
-mesh::Mesh box_mesh(double lx, double ly, double lz, int nx, int ny, int nz, int element_order,
-                    double perturbation, std::uint32_t seed) {
+mesh::Mesh box_mesh(double lx, double ly, double lz, int nx, int ny, int nz, int element_order, double perturbation,
+                    std::uint32_t seed) {
   SHROUDSIM_CHECK(nx > 0 && ny > 0 && nz > 0, "box_mesh: cell counts must be positive");
   SHROUDSIM_CHECK(element_order == 1 || element_order == 2, "box_mesh: order 1 or 2");
   const double hx = lx / nx, hy = ly / ny, hz = lz / nz;
@@ -222,7 +222,8 @@ mesh::Mesh replicate_wheel(const mesh::Mesh& sector) {
     Eigen::Matrix3d R;
     R << std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1;
     for (int v = 0; v < n; ++v)
-      if (kept_index[v] >= 0) w.nodes.row(k * n_kept + kept_index[v]) = (R * sector.nodes.row(v).transpose()).transpose();
+      if (kept_index[v] >= 0)
+        w.nodes.row(k * n_kept + kept_index[v]) = (R * sector.nodes.row(v).transpose()).transpose();
     for (int e = 0; e < sector.n_elements(); ++e)
       for (int a2 = 0; a2 < sector.nodes_per_element(); ++a2)
         w.tets(k * sector.n_elements() + e, a2) = wheel_node(k, sector.tets(e, a2));

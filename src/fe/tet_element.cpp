@@ -53,7 +53,6 @@ Eigen::Matrix<double, 10, 3> TetShape<10>::gradients(const Eigen::Vector3d& xi) 
   return g;
 }
 
-
 namespace {
 
 // Shape values and reference gradients tabulated at the points of one rule.
@@ -78,8 +77,7 @@ constexpr int kMassDegree = 2 * (NPE == 4 ? 1 : 2);
 }  // namespace
 
 template <int NPE>
-bool tet_matrices(const ElementNodes<NPE>& X, const Material& material, ElementMatrix<NPE>& K,
-                  ElementMatrix<NPE>& M) {
+bool tet_matrices(const ElementNodes<NPE>& X, const Material& material, ElementMatrix<NPE>& K, ElementMatrix<NPE>& M) {
   static const Tabulated<NPE> kq(tet_quadrature(kStiffnessDegree<NPE>));
   static const Tabulated<NPE> mq(tet_quadrature(kMassDegree<NPE>));
   const double lambda = material.lame_lambda();
@@ -130,9 +128,7 @@ double tet_volume(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const Ei
   return (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
 }
 
-template bool tet_matrices<4>(const ElementNodes<4>&, const Material&, ElementMatrix<4>&,
-                              ElementMatrix<4>&);
-template bool tet_matrices<10>(const ElementNodes<10>&, const Material&, ElementMatrix<10>&,
-                               ElementMatrix<10>&);
+template bool tet_matrices<4>(const ElementNodes<4>&, const Material&, ElementMatrix<4>&, ElementMatrix<4>&);
+template bool tet_matrices<10>(const ElementNodes<10>&, const Material&, ElementMatrix<10>&, ElementMatrix<10>&);
 
 }  // namespace shroudsim::fe

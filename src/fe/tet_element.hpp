@@ -47,8 +47,7 @@ using ElementNodes = Eigen::Matrix<double, NPE, 3>;
 /// Returns false (and leaves K, M undefined) if the Jacobian determinant is not positive at
 /// some quadrature point (inverted or degenerate element).
 template <int NPE>
-bool tet_matrices(const ElementNodes<NPE>& X, const Material& material, ElementMatrix<NPE>& K,
-                  ElementMatrix<NPE>& M);
+bool tet_matrices(const ElementNodes<NPE>& X, const Material& material, ElementMatrix<NPE>& K, ElementMatrix<NPE>& M);
 
 /// Volume of a tetrahedron from its four vertices (positive for gmsh orientation).
 double tet_volume(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
@@ -62,9 +61,7 @@ template <>
 Eigen::Matrix<double, 10, 1> TetShape<10>::values(const Eigen::Vector3d& xi);
 template <>
 Eigen::Matrix<double, 10, 3> TetShape<10>::gradients(const Eigen::Vector3d& xi);
-extern template bool tet_matrices<4>(const ElementNodes<4>&, const Material&, ElementMatrix<4>&,
-                                     ElementMatrix<4>&);
-extern template bool tet_matrices<10>(const ElementNodes<10>&, const Material&, ElementMatrix<10>&,
-                                      ElementMatrix<10>&);
+extern template bool tet_matrices<4>(const ElementNodes<4>&, const Material&, ElementMatrix<4>&, ElementMatrix<4>&);
+extern template bool tet_matrices<10>(const ElementNodes<10>&, const Material&, ElementMatrix<10>&, ElementMatrix<10>&);
 
 }  // namespace shroudsim::fe

@@ -15,8 +15,7 @@ namespace {
 struct PeakPair {
   double a = 0.0, fa = 0.0, b = 0.0, fb = 0.0;
 };
-std::vector<PeakPair> peak_pairs(const Curve& a,
-                                 const Curve& b) {
+std::vector<PeakPair> peak_pairs(const Curve& a, const Curve& b) {
   std::vector<PeakPair> out;
   for (int pass = 0; pass < 2; ++pass) {
     const auto& x = pass == 0 ? a : b;
@@ -56,7 +55,6 @@ double peaks_shift_hz(const Curve& a, const Curve& b) {
   return worst;
 }
 
-
 namespace {
 
 int pow2_at_least(int v) {
@@ -94,7 +92,8 @@ DiscretizationSearch search_discretization(const DiscretizationSettings& s,
       if (hk > s.max_harmonics) break;
       const int nk = s.time_samples_auto ? std::max(256, pow2_at_least(16 * (2 * hk + 1))) : s.time_samples;
       if (nk < 2 * hk + 1) break;  // a fixed N limits H
-      const std::size_t i = trial(hk, nk, trials.empty() ? std::nullopt : std::optional<std::size_t>(trials.size() - 1));
+      const std::size_t i =
+          trial(hk, nk, trials.empty() ? std::nullopt : std::optional<std::size_t>(trials.size() - 1));
       h = hk, n = nk;
       if (trials[i].relative_change >= 0 && trials[i].relative_change < s.tolerance) {
         out.harmonics_converged = true;
@@ -129,7 +128,8 @@ DiscretizationSearch search_discretization(const DiscretizationSettings& s,
   for (std::size_t i = 0; i < trials.size(); ++i)
     if (trials[i].harmonics == h && trials[i].time_samples == n) out.chosen = i, found = true;
   if (!found)
-    throw std::invalid_argument("no H/N candidate fits the limits (auto_max_harmonics, auto_max_time_samples, time_samples >= 2H+1)");
+    throw std::invalid_argument(
+        "no H/N candidate fits the limits (auto_max_harmonics, auto_max_time_samples, time_samples >= 2H+1)");
   out.harmonics = h;
   out.time_samples = n;
   return out;

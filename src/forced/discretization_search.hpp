@@ -43,16 +43,16 @@ struct DiscretizationSettings {
   bool harmonics_auto = false, time_samples_auto = false;
   int harmonics = 5, time_samples = 512;  ///< the fixed values (or ignored when "auto")
   int max_harmonics = 25, max_time_samples = 4096;
-  double tolerance = 0.01;                ///< relative change of the peaks that stops a search
+  double tolerance = 0.01;  ///< relative change of the peaks that stops a search
 };
 
 struct DiscretizationTrial {
   int harmonics = 0, time_samples = 0;
-  bool ok = false;                 ///< the curve reached the end (the trial's own status)
-  std::string message;             ///< why not, when !ok
+  bool ok = false;      ///< the curve reached the end (the trial's own status)
+  std::string message;  ///< why not, when !ok
   double peak_amplitude_m = 0.0, peak_frequency_hz = 0.0;
   double seconds = 0.0;
-  double relative_change = -1.0;   ///< peaks_change against the trial it was compared with (-1: none)
+  double relative_change = -1.0;  ///< peaks_change against the trial it was compared with (-1: none)
   Curve curve;
 };
 
@@ -60,7 +60,7 @@ struct DiscretizationSearch {
   std::vector<DiscretizationTrial> trials;  ///< every trial, in the order run
   int harmonics = 0, time_samples = 0;      ///< chosen
   bool harmonics_converged = false, time_samples_converged = false;
-  std::size_t chosen = 0;                   ///< index into trials
+  std::size_t chosen = 0;  ///< index into trials
 };
 
 /// run(h, n) traces one trial (filling ok, message, peaks, curve; seconds are measured here);

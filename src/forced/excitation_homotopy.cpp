@@ -53,7 +53,7 @@ continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, d
   o.initial_step = 0.05;
   o.max_step = 4.0;
   o.max_points = std::min(o.max_points, 2000);  // a start that needs more is not worth waiting for
-  o.start_slack = 1.0;  // the path may fold back through s < 0 (the excitation reversed)
+  o.start_slack = 1.0;                          // the path may fold back through s < 0 (the excitation reversed)
   const double saved = equations.excitation_scale();
   equations.set_excitation_scale(0.0);
   const Eigen::VectorXd start = equations.stuck_solution(frequency_hz);

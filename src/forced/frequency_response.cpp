@@ -101,9 +101,10 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   start = equations.stuck_solution(f);
   const continuation::Branch h = solve_by_excitation_homotopy(equations, f, ao, start);
   if (h.status != continuation::BranchStatus::kReachedEnd)
-    throw NumericalError("no solution at the start frequency " + number(f) +
-                         " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
-                         h.message);
+    throw NumericalError(
+        "no solution at the start frequency " + number(f) +
+        " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
+        h.message);
   say(info, "frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) +
                 " points)");
   return start;
@@ -175,8 +176,9 @@ continuation::ArclengthOptions arclength_options(const FrequencyResponseSettings
   const double motion = free_motion_peak(*model.linear, equations, s.frequency_start_hz, s.frequency_end_hz);
   double contact_scale = 0.0;
   for (const auto& p : model.pairs)
-    contact_scale = std::max({contact_scale, p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness,
-                              std::abs(p.normal_preload) / p.normal_stiffness});
+    contact_scale =
+        std::max({contact_scale, p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness,
+                  std::abs(p.normal_preload) / p.normal_stiffness});
   const double x_unit = motion > 0 ? motion / kFreePeakUnits
                                    : (contact_scale > 0 && std::isfinite(contact_scale) ? contact_scale : 1.0);
   const double lambda_unit = std::abs(s.frequency_end_hz - s.frequency_start_hz) / kRangeUnits;
@@ -225,8 +227,9 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
   const continuation::ArclengthOptions ao = arclength_options(settings, model, equations);
   out.options = ao;
   const Eigen::VectorXd start = find_start_logged(model, eo, equations, ao, ao.lambda_start, out.start, info);
-  continuation::Branch first =
-      continuation::trace(equations, start, ao, [&](const continuation::BranchPoint& p) { if (progress) progress(p, 0); });
+  continuation::Branch first = continuation::trace(equations, start, ao, [&](const continuation::BranchPoint& p) {
+    if (progress) progress(p, 0);
+  });
   out.points = first.points;
   out.piece.assign(out.points.size(), 0);
   out.summary = first;
@@ -240,8 +243,10 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
   // reported as two separate branches; otherwise the curve stops where the pieces did.
   const double direction = ao.lambda_end > ao.lambda_start ? 1.0 : -1.0;
   double reached = ao.lambda_start;
-  for (const auto& p : first.points) reached = direction > 0 ? std::max(reached, p.lambda) : std::min(reached, p.lambda);
-  if (first.status != continuation::BranchStatus::kReachedEnd && first.status != continuation::BranchStatus::kStartFailed &&
+  for (const auto& p : first.points)
+    reached = direction > 0 ? std::max(reached, p.lambda) : std::min(reached, p.lambda);
+  if (first.status != continuation::BranchStatus::kReachedEnd &&
+      first.status != continuation::BranchStatus::kStartFailed &&
       first.status != continuation::BranchStatus::kMaxPoints) {
     const std::string first_message = first.message;
     say(info, "frf: the branch from " + number(ao.lambda_start) + " Hz stopped (" + first.message +
@@ -249,7 +254,8 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
     continuation::ArclengthOptions back = ao;
     back.lambda_start = ao.lambda_end;
     const double overlap = 4.0 * ao.initial_step * ao.lambda_scale;
-    back.lambda_end = direction > 0 ? std::max(ao.lambda_start, reached - overlap) : std::min(ao.lambda_start, reached + overlap);
+    back.lambda_end = direction > 0 ? std::max(ao.lambda_start, reached - overlap)
+                                    : std::min(ao.lambda_start, reached + overlap);
     back.max_points = std::max(1, ao.max_points - static_cast<int>(out.points.size()));
     out.two_pieces = true;
     try {
@@ -280,8 +286,8 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
                      "(frf.csv column `piece`)");
       } else if (second.status != continuation::BranchStatus::kReachedEnd) {
         out.pieces_join = false;
-        out.summary.message = first_message + "; tracing back from " + number(ao.lambda_end) + " Hz stopped too: " +
-                              second.message;
+        out.summary.message =
+            first_message + "; tracing back from " + number(ao.lambda_end) + " Hz stopped too: " + second.message;
       } else {
         out.join_distance = continuation::distance_to_branch(equations, ao, first.points, second.points.back());
         // Two solutions of the same equations to tolerance agree far within a step.
@@ -295,9 +301,10 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
           // they were not shown to be one branch (typically the two stable sides of a fold
           // pair, the unstable branch between them left untraced): reported as two branches.
           covered_with("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
-                       " Hz stopped at " + number(reached) + " Hz (" + first_message + "); the branch traced back from " +
-                       number(ao.lambda_end) + " Hz covers the rest but does not join it (scaled distance " +
-                       number(out.join_distance) + "; frf.csv column `piece`)");
+                       " Hz stopped at " + number(reached) + " Hz (" + first_message +
+                       "); the branch traced back from " + number(ao.lambda_end) +
+                       " Hz covers the rest but does not join it (scaled distance " + number(out.join_distance) +
+                       "; frf.csv column `piece`)");
         }
       }
       for (const auto& p : second.points) {
@@ -348,14 +355,16 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
       if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
         int evaluations = 0;
         continuation::ScaledSystem sys(equations, ao, &evaluations);
-        auto amplitude = [&](const Eigen::VectorXd& x, double lambda) { return equations.analyse(x, lambda).amplitude; };
+        auto amplitude = [&](const Eigen::VectorXd& x, double lambda) {
+          return equations.analyse(x, lambda).amplitude;
+        };
         // On the two steps beside the sampled maximum, each parametrized by the arclength
         // along the tangent of its first point.
         for (std::size_t from : {idx[m - 1], i}) {
           const std::size_t to = from == i ? idx[m + 1] : i;
           const continuation::BranchPoint& p = out.points[from];
-          const double length = p.tangent.dot(sys.to_scaled(out.points[to].x, out.points[to].lambda) -
-                                              sys.to_scaled(p.x, p.lambda));
+          const double length =
+              p.tangent.dot(sys.to_scaled(out.points[to].x, out.points[to].lambda) - sys.to_scaled(p.x, p.lambda));
           if (!(length > 0)) continue;
           const continuation::Extremum e = continuation::locate_maximum(equations, ao, p, length, amplitude);
           out.summary.residual_evaluations += e.evaluations;

@@ -39,7 +39,7 @@ struct FrequencyResponseSettings {
   double frequency_end_hz = 220.0;
   double initial_step_hz = 0.0;  ///< Hz-equivalent arclength; <= 0: "auto" (0.25 units)
   int max_points = 5000;
-  double tolerance = 1e-8;       ///< Newton tolerance on the scaled residual
+  double tolerance = 1e-8;  ///< Newton tolerance on the scaled residual
   bool locate_peaks = true;
 };
 
@@ -71,9 +71,9 @@ Eigen::VectorXd find_start(const ForcedModel& model, const hbm::ContactEvaluator
 struct ResponsePeak {
   double frequency_hz = 0.0;
   double amplitude_m = 0.0;
-  std::size_t point = 0;   ///< the sampled point nearest to it (index into points)
+  std::size_t point = 0;  ///< the sampled point nearest to it (index into points)
   int piece = 0;
-  bool located = false;    ///< located to solver tolerance (false: the sampled maximum)
+  bool located = false;  ///< located to solver tolerance (false: the sampled maximum)
 };
 
 struct FrequencyResponse {
@@ -86,10 +86,10 @@ struct FrequencyResponse {
   std::string start, start_second_piece;          ///< how the start points were found
   bool two_pieces = false;
   bool pieces_join = true;
-  double join_distance = 0.0;                     ///< scaled distance at the join check
+  double join_distance = 0.0;  ///< scaled distance at the join check
   std::vector<std::string> warnings;
-  double peak_seconds = 0.0;                      ///< time spent locating peaks
-  int polished_points = 0;                        ///< points re-solved at their own scale for the energy balance
+  double peak_seconds = 0.0;  ///< time spent locating peaks
+  int polished_points = 0;    ///< points re-solved at their own scale for the energy balance
 };
 
 /// The forced response over the range. progress is called for every point that stays on the
@@ -97,8 +97,7 @@ struct FrequencyResponse {
 /// is found; any other failure is in summary.status / summary.message with what was traced.
 FrequencyResponse trace_frequency_response(
     const FrequencyResponseSettings& settings, const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
-    ReducedEquations& equations,
-    const std::function<void(const continuation::BranchPoint&, int piece)>& progress = {},
+    ReducedEquations& equations, const std::function<void(const continuation::BranchPoint&, int piece)>& progress = {},
     const std::function<void(const std::string&)>& info = {});
 
 /// The local maxima of a sequence of amplitudes that stand out: prominence (the drop to the

@@ -139,17 +139,19 @@ const ReducedEquations::Harmonics& ReducedEquations::harmonics(double frequency_
   return harmonics_;
 }
 
-void ReducedEquations::apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const {
+void ReducedEquations::apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v,
+                             Eigen::VectorXd& out) const {
   out.setZero(size());
-  for (std::size_t n = 0; n < m.size(); ++n) add_harmonic(m[n] * complex_harmonic(v, static_cast<int>(n)), static_cast<int>(n), out);
+  for (std::size_t n = 0; n < m.size(); ++n)
+    add_harmonic(m[n] * complex_harmonic(v, static_cast<int>(n)), static_cast<int>(n), out);
 }
 
 void ReducedEquations::jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks, Eigen::MatrixXd& J) {
   jacobian_from(harmonics(frequency_hz, false).g, blocks, J);
 }
 
-void ReducedEquations::jacobian_from(const std::vector<Eigen::MatrixXcd>& g_n, const std::vector<Eigen::MatrixXd>& blocks,
-                                     Eigen::MatrixXd& J) {
+void ReducedEquations::jacobian_from(const std::vector<Eigen::MatrixXcd>& g_n,
+                                     const std::vector<Eigen::MatrixXd>& blocks, Eigen::MatrixXd& J) {
   log::Stopwatch clock;
   const auto& layout = contacts_.pair_layout();
   const int h = layout.n_harmonics(), pairs = contacts_.n_pairs(), block = layout.size(), nd = n_directions_;
@@ -201,7 +203,8 @@ void ReducedEquations::jacobian_from(const std::vector<Eigen::MatrixXcd>& g_n, c
   stats_.jacobian_seconds += clock.seconds();
 }
 
-Eigen::MatrixXd ReducedEquations::dense_jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks) const {
+Eigen::MatrixXd ReducedEquations::dense_jacobian(double frequency_hz,
+                                                 const std::vector<Eigen::MatrixXd>& blocks) const {
   Eigen::MatrixXd g;
   assemble(frequency_hz, g, nullptr);
   const int block = contacts_.pair_layout().size();
@@ -211,8 +214,8 @@ Eigen::MatrixXd ReducedEquations::dense_jacobian(double frequency_hz, const std:
   return J;
 }
 
-bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r,
-                                Eigen::MatrixXd* J, Eigen::VectorXd* dr_dlambda) {
+bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r, Eigen::MatrixXd* J,
+                                Eigen::VectorXd* dr_dlambda) {
   return evaluate_impl(w, frequency_hz, r, J, dr_dlambda, false);
 }
 
@@ -432,8 +435,10 @@ PointResult ReducedEquations::analyse(const Eigen::VectorXd& w, double frequency
   for (int p = 0; p < contacts_.n_pairs(); ++p)
     res.contact_dissipation +=
         hbm::dissipated_energy(contacts_.pair_layout(), w.segment(p * block, block), f_.segment(p * block, block));
-  const double scale = std::max({std::abs(res.excitation_work), res.viscous_dissipation, std::abs(res.contact_dissipation)});
-  res.energy_error = scale > 0 ? std::abs(res.excitation_work - res.viscous_dissipation - res.contact_dissipation) / scale : 0.0;
+  const double scale =
+      std::max({std::abs(res.excitation_work), res.viscous_dissipation, std::abs(res.contact_dissipation)});
+  res.energy_error =
+      scale > 0 ? std::abs(res.excitation_work - res.viscous_dissipation - res.contact_dissipation) / scale : 0.0;
   return res;
 }
 

@@ -44,42 +44,42 @@ namespace shroudsim::forced {
 /// Everything reported about one solution point.
 struct PointResult {
   double frequency_hz = 0.0;
-  double amplitude = 0.0;              ///< max_t |u_resp(t)| [m]
-  double linear_amplitude = 0.0;       ///< the same without contact forces (free) [m]
+  double amplitude = 0.0;                   ///< max_t |u_resp(t)| [m]
+  double linear_amplitude = 0.0;            ///< the same without contact forces (free) [m]
   std::vector<double> harmonic_amplitudes;  ///< |U_n| [m], n = 0..H
-  double excitation_work = 0.0;        ///< per period [J]
-  double viscous_dissipation = 0.0;    ///< per period [J]
-  double contact_dissipation = 0.0;    ///< per period [J]
-  double energy_error = 0.0;           ///< |work - dissipation| / work (0 when work ~ 0)
+  double excitation_work = 0.0;             ///< per period [J]
+  double viscous_dissipation = 0.0;         ///< per period [J]
+  double contact_dissipation = 0.0;         ///< per period [J]
+  double energy_error = 0.0;                ///< |work - dissipation| / work (0 when work ~ 0)
   int unconverged_pairs = 0;
 };
 
 /// How the augmented Newton systems are solved.
 struct LinearSolverOptions {
   enum class Kind { dense, krylov, automatic };
-  Kind kind = Kind::automatic;     ///< automatic: krylov from krylov_min_size unknowns on
-  int krylov_min_size = 250;       ///< (n + 1) below which automatic uses the dense LU
-  int krylov_max_iterations = 40;  ///< GMRES iterations before falling back to a new LU
-  int refactor_after = 15;         ///< GMRES iterations above which the next solve refactors
-                                   ///< (matrix-free solves: once the GMRES iterations since
-                                   ///< the last factorization have also cost more flops)
-  double krylov_tolerance = 1e-11; ///< relative true residual ||A d - b|| / ||b||
+  Kind kind = Kind::automatic;      ///< automatic: krylov from krylov_min_size unknowns on
+  int krylov_min_size = 250;        ///< (n + 1) below which automatic uses the dense LU
+  int krylov_max_iterations = 40;   ///< GMRES iterations before falling back to a new LU
+  int refactor_after = 15;          ///< GMRES iterations above which the next solve refactors
+                                    ///< (matrix-free solves: once the GMRES iterations since
+                                    ///< the last factorization have also cost more flops)
+  double krylov_tolerance = 1e-11;  ///< relative true residual ||A d - b|| / ||b||
 };
 
 /// Where the time goes (seconds of wall time, counts), accumulated over the object's life.
 struct SolverStatistics {
-  int evaluations = 0;             ///< residual evaluations that reached the contacts
-  int jacobian_evaluations = 0;    ///< of those, with the Jacobian
-  int repeated_evaluations = 0;    ///< served from the copy of the previous evaluation
-  int dense_factorizations = 0;    ///< LU factorizations of an augmented matrix
-  int krylov_solves = 0;           ///< solves done by preconditioned GMRES
-  int krylov_iterations = 0;       ///< their GMRES iterations
-  int krylov_failures = 0;         ///< GMRES solves that fell back to a new LU
-  int double_solves = 0;           ///< bordered solves where the single-precision factors failed
-  double contact_seconds = 0.0;    ///< ContactEvaluator::evaluate
-  double receptance_seconds = 0.0; ///< G_n, W_lin,n and their frequency derivatives
-  double jacobian_seconds = 0.0;   ///< forming I + G D
-  double solve_seconds = 0.0;      ///< solve_augmented and solve_bordered
+  int evaluations = 0;              ///< residual evaluations that reached the contacts
+  int jacobian_evaluations = 0;     ///< of those, with the Jacobian
+  int repeated_evaluations = 0;     ///< served from the copy of the previous evaluation
+  int dense_factorizations = 0;     ///< LU factorizations of an augmented matrix
+  int krylov_solves = 0;            ///< solves done by preconditioned GMRES
+  int krylov_iterations = 0;        ///< their GMRES iterations
+  int krylov_failures = 0;          ///< GMRES solves that fell back to a new LU
+  int double_solves = 0;            ///< bordered solves where the single-precision factors failed
+  double contact_seconds = 0.0;     ///< ContactEvaluator::evaluate
+  double receptance_seconds = 0.0;  ///< G_n, W_lin,n and their frequency derivatives
+  double jacobian_seconds = 0.0;    ///< forming I + G D
+  double solve_seconds = 0.0;       ///< solve_augmented and solve_bordered
 };
 
 class ReducedEquations : public continuation::ParametricResidual {
@@ -165,8 +165,8 @@ class ReducedEquations : public continuation::ParametricResidual {
   hbm::ContactEvaluator& contacts_;
   int n_directions_;
   double excitation_scale_ = 1.0;
-  Eigen::VectorXd f_;                       // scratch: contact forces
-  std::vector<Eigen::MatrixXd> blocks_;     // scratch: dF_p/dW_p
+  Eigen::VectorXd f_;                    // scratch: contact forces
+  std::vector<Eigen::MatrixXd> blocks_;  // scratch: dF_p/dW_p
   Harmonics harmonics_;
   LinearSolverOptions solver_;
   SolverStatistics stats_;

@@ -62,7 +62,8 @@ std::vector<int> spread(const mesh::Mesh& m, const std::vector<ShroudFaceNode>& 
     const int current = next;
     double far = -1.0;
     for (std::size_t i = 0; i < face.size(); ++i) {
-      dist[i] = std::min(dist[i], (m.nodes.row(face[i].high) - m.nodes.row(face[static_cast<std::size_t>(current)].high)).norm());
+      dist[i] = std::min(
+          dist[i], (m.nodes.row(face[i].high) - m.nodes.row(face[static_cast<std::size_t>(current)].high)).norm());
       if (dist[i] > far) far = dist[i], next = static_cast<int>(i);
     }
   }
@@ -75,8 +76,9 @@ std::vector<ContactPatch> partition_face(const mesh::Mesh& m, const std::vector<
   const int n = static_cast<int>(face.size());
   if (n == 0) throw std::invalid_argument("the mesh has no matched shroud node pairs");
   if (count < 0 || count > n)
-    throw std::invalid_argument("pairs = " + std::to_string(count) + " violates: pairs <= matched shroud node pairs of the mesh (" +
-                                std::to_string(n) + ")");
+    throw std::invalid_argument("pairs = " + std::to_string(count) +
+                                " violates: pairs <= matched shroud node pairs of the mesh (" + std::to_string(n) +
+                                ")");
   std::vector<int> seeds(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) seeds[static_cast<std::size_t>(i)] = i;
   if (count != 0 && count < n) seeds = spread(m, face, count);
@@ -88,7 +90,8 @@ std::vector<ContactPatch> partition_face(const mesh::Mesh& m, const std::vector<
     double d_best = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < seeds.size(); ++k) {
       const double d = (m.nodes.row(face[static_cast<std::size_t>(i)].high) -
-                        m.nodes.row(face[static_cast<std::size_t>(seeds[k])].high)).norm();
+                        m.nodes.row(face[static_cast<std::size_t>(seeds[k])].high))
+                           .norm();
       if (d < d_best) d_best = d, best = k;
     }
     patches[best].members.push_back(i);
@@ -100,7 +103,8 @@ std::vector<ContactPatch> partition_face(const mesh::Mesh& m, const std::vector<
       normal += face[static_cast<std::size_t>(i)].area * face[static_cast<std::size_t>(i)].normal;
     }
     for (int i : p.members)
-      p.weights.push_back(p.area > 0 ? face[static_cast<std::size_t>(i)].area / p.area : 1.0 / static_cast<double>(p.members.size()));
+      p.weights.push_back(p.area > 0 ? face[static_cast<std::size_t>(i)].area / p.area
+                                     : 1.0 / static_cast<double>(p.members.size()));
     // A single pair keeps its own (already unit) normal: the node form, bit for bit.
     if (p.members.size() == 1 || !(normal.norm() > 0)) normal = face[static_cast<std::size_t>(p.seed)].normal;
     else normal.normalize();
@@ -128,7 +132,8 @@ std::vector<cyclic::InterfaceSpring> face_springs(const mesh::Mesh& m, const std
                                                   double frame_angle) {
   double area = 0.0;
   for (const auto& f : face) area += f.area;
-  if (face.empty() || !(area > 0)) throw std::invalid_argument("the mesh has no matched shroud_high/shroud_low node pairs");
+  if (face.empty() || !(area > 0))
+    throw std::invalid_argument("the mesh has no matched shroud_high/shroud_low node pairs");
   std::vector<cyclic::InterfaceSpring> springs;
   springs.reserve(face.size());
   for (const auto& f : face) {

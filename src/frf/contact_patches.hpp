@@ -29,19 +29,19 @@ namespace shroudsim::frf {
 
 /// One matched node pair of the shroud face.
 struct ShroudFaceNode {
-  int high = -1, low = -1;                          ///< q on shroud_high, p on shroud_low
-  double area = 0.0;                                ///< tributary area on shroud_high [m^2]
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero(); ///< unit, outward of shroud_high (+theta)
+  int high = -1, low = -1;                           ///< q on shroud_high, p on shroud_low
+  double area = 0.0;                                 ///< tributary area on shroud_high [m^2]
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit, outward of shroud_high (+theta)
 };
 
 /// Every matched shroud pair (ordered by its high node) with area and normal.
 std::vector<ShroudFaceNode> shroud_face(const mesh::Mesh& mesh);
 
 struct ContactPatch {
-  int seed = -1;                ///< index into the face of the patch's seed pair
-  std::vector<int> members;     ///< indices into the face, ascending
-  std::vector<double> weights;  ///< a_i / A_P of each member (sum 1)
-  double area = 0.0;            ///< A_P [m^2]
+  int seed = -1;                                     ///< index into the face of the patch's seed pair
+  std::vector<int> members;                          ///< indices into the face, ascending
+  std::vector<double> weights;                       ///< a_i / A_P of each member (sum 1)
+  double area = 0.0;                                 ///< A_P [m^2]
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit area-weighted mean normal
 };
 

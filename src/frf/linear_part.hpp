@@ -20,10 +20,10 @@
 namespace shroudsim::frf {
 
 struct HarmonicReceptance {
-  Eigen::MatrixXcd G;       ///< c x c
-  Eigen::VectorXcd w_lin;   ///< c
-  Eigen::MatrixXcd H;       ///< d x c
-  Eigen::VectorXcd u_lin;   ///< d
+  Eigen::MatrixXcd G;      ///< c x c
+  Eigen::VectorXcd w_lin;  ///< c
+  Eigen::MatrixXcd H;      ///< d x c
+  Eigen::VectorXcd u_lin;  ///< d
 };
 
 class LinearPart {

@@ -11,8 +11,7 @@
 namespace shroudsim::frf {
 
 LumpedLinearPart::LumpedLinearPart(Eigen::MatrixXd mass, Eigen::MatrixXd stiffness, Eigen::MatrixXd damping,
-                                   std::vector<LumpedContact> contacts, int excited_dof, double force,
-                                   int response_dof)
+                                   std::vector<LumpedContact> contacts, int excited_dof, double force, int response_dof)
     : m_(std::move(mass)),
       k_(std::move(stiffness)),
       c_(std::move(damping)),

@@ -41,8 +41,8 @@ Eigen::SparseMatrix<Complex> selection(const std::vector<SectorContactPair>& pai
 
 }  // namespace
 
-Eigen::SparseMatrix<Complex> contact_rows(const std::vector<SectorContactPair>& pairs, const cyclic::CyclicSector& sector,
-                                          int h, Eigen::Index n_full) {
+Eigen::SparseMatrix<Complex> contact_rows(const std::vector<SectorContactPair>& pairs,
+                                          const cyclic::CyclicSector& sector, int h, Eigen::Index n_full) {
   std::vector<Eigen::Triplet<Complex>> t;
   add_contact_rows(t, pairs, sector, h);
   Eigen::SparseMatrix<Complex> m(3 * static_cast<Eigen::Index>(pairs.size()), n_full);
@@ -148,10 +148,8 @@ void SectorLinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG
   }
   const auto psi_c = d.psi.topRows(c);
   dG = psi_c * dinv.asDiagonal() * psi_c.adjoint();
-  if (n == 1)
-    dw_lin = psi_c * dinv.asDiagonal() * d.psi.row(c + 3).adjoint();
-  else
-    dw_lin = Eigen::VectorXcd::Zero(c);
+  if (n == 1) dw_lin = psi_c * dinv.asDiagonal() * d.psi.row(c + 3).adjoint();
+  else dw_lin = Eigen::VectorXcd::Zero(c);
 }
 
 void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
@@ -175,7 +173,7 @@ void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& for
     }
     if (n == 1) {
       const Complex u_e = (receptance(1, w) * g)[c + 3];  // E U_1: displacement along the force
-      excitation_work += kPi * (-u_e.imag());            // pi Im(1 * conj(U_e))
+      excitation_work += kPi * (-u_e.imag());             // pi Im(1 * conj(U_e))
     }
   }
 }
@@ -184,7 +182,8 @@ std::vector<double> SectorLinearPart::resonances_hz() const {
   std::vector<double> f;
   const auto it = dynamic_.find(harmonic_index(1));
   if (it == dynamic_.end()) return f;
-  for (Eigen::Index r = 0; r < it->second.omega.size(); ++r) f.push_back(it->second.omega[r] / (2.0 * std::numbers::pi));
+  for (Eigen::Index r = 0; r < it->second.omega.size(); ++r)
+    f.push_back(it->second.omega[r] / (2.0 * std::numbers::pi));
   std::sort(f.begin(), f.end());
   return f;
 }

@@ -34,8 +34,8 @@ struct PatchNode {
 };
 
 struct SectorContactPair {
-  int high_node = -1;   ///< q: shroud_high node of the reference sector
-  int low_node = -1;    ///< p: its matched shroud_low node (x_q = R x_p)
+  int high_node = -1;                                   ///< q: shroud_high node of the reference sector
+  int low_node = -1;                                    ///< p: its matched shroud_low node (x_q = R x_p)
   Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();  ///< rows t1, t2, n (n outward of shroud_high)
   /// Empty: the element acts on the node pair (high_node, low_node). Otherwise on the
   /// weighted mean of these node pairs, W = L sum_i weight_i (U_q_i - exp(i h alpha) R U_p_i),
@@ -44,11 +44,11 @@ struct SectorContactPair {
 };
 
 struct SectorForcing {
-  int engine_order = 1;              ///< m: harmonic n lives in h = n m mod Nb
+  int engine_order = 1;  ///< m: harmonic n lives in h = n m mod Nb
   int excitation_node = -1;
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< amplitude [N], global x y z (harmonic 1)
   int response_node = -1;
-  double damping_ratio = 0.001;      ///< modal damping of every mode
+  double damping_ratio = 0.001;  ///< modal damping of every mode
   bool residual_flexibility = true;
 };
 
@@ -83,9 +83,9 @@ class SectorLinearPart : public LinearPart {
 
  private:
   struct IndexData {
-    Eigen::VectorXd omega;       ///< modes kept [rad/s]
-    Eigen::MatrixXcd psi;        ///< k x modes: C T_h phi
-    Eigen::MatrixXcd flex;       ///< k x k: residual flexibility (n >= 1) or static flexibility (h used for n = 0)
+    Eigen::VectorXd omega;  ///< modes kept [rad/s]
+    Eigen::MatrixXcd psi;   ///< k x modes: C T_h phi
+    Eigen::MatrixXcd flex;  ///< k x k: residual flexibility (n >= 1) or static flexibility (h used for n = 0)
   };
   /// Q_n(W) (k x k).
   Eigen::MatrixXcd receptance(int n, double w) const;
@@ -93,8 +93,8 @@ class SectorLinearPart : public LinearPart {
   std::vector<SectorContactPair> pairs_;
   SectorForcing forcing_;
   int sectors_ = 1, n_harmonics_ = 0;
-  std::map<int, IndexData> dynamic_;   ///< per harmonic index of n >= 1
-  IndexData static_;                   ///< n = 0 (h = 0): exact static flexibility in flex
+  std::map<int, IndexData> dynamic_;  ///< per harmonic index of n >= 1
+  IndexData static_;                  ///< n = 0 (h = 0): exact static flexibility in flex
 };
 
 }  // namespace shroudsim::frf

@@ -31,8 +31,8 @@ StaticShroud face_elements(const mesh::Mesh& mesh, const StaticShroudSettings& s
   StaticShroud out;
   out.face = shroud_face(mesh);
   try {
-    out.springs = face_springs(mesh, out.face, settings.normal_stiffness, settings.tangential_stiffness,
-                               settings.frame_angle);
+    out.springs =
+        face_springs(mesh, out.face, settings.normal_stiffness, settings.tangential_stiffness, settings.frame_angle);
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what());
   }
@@ -97,8 +97,7 @@ StaticShroud solve_static_shroud(const mesh::Mesh& mesh, const linalg::SparsePai
 }
 
 std::vector<contact::PairParameters> patch_parameters(const std::vector<ContactPatch>& patches, double face_area,
-                                                      const contact::PairParameters& face,
-                                                      const StaticShroud* state) {
+                                                      const contact::PairParameters& face, const StaticShroud* state) {
   std::vector<contact::PairParameters> out;
   for (const auto& p : patches) {
     const double s = p.area / face_area;

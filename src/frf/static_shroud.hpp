@@ -11,8 +11,8 @@
 // rotating stiffness of modal/rotating.hpp, prestress from the open-shroud static solution)
 // and the contact problem g = g_ext - C F(g) (contact/static_contact.hpp) is solved with
 // the exact static flexibility C = B K_0^-1 B^T of the pairs (B: the springs' relative
-// displacement rows at h = 0, CyclicSector::interface_rows) and g_ext = B K_0^-1 T_0^T Omega_k^2 f1. At zero speed one step applies the
-// interference alone.
+// displacement rows at h = 0, CyclicSector::interface_rows) and g_ext = B K_0^-1 T_0^T Omega_k^2 f1. At zero speed one
+// step applies the interference alone.
 //
 // Usage:
 //   frf::StaticShroud s = frf::solve_static_shroud(mesh, km, ops_or_null, settings);
@@ -31,22 +31,22 @@ namespace shroudsim::frf {
 
 struct StaticShroudSettings {
   double speed_rad_s = 0.0;
-  int increments = 10;               ///< steps of Omega^2 from rest (>= 1; 1 at zero speed)
-  double interference = 0.0;         ///< delta [m], overlap at rest; < 0: a gap
-  double normal_stiffness = 0.0;     ///< kn [N/m] of the whole face
-  double tangential_stiffness = 0.0; ///< kt [N/m] of the whole face
+  int increments = 10;                ///< steps of Omega^2 from rest (>= 1; 1 at zero speed)
+  double interference = 0.0;          ///< delta [m], overlap at rest; < 0: a gap
+  double normal_stiffness = 0.0;      ///< kn [N/m] of the whole face
+  double tangential_stiffness = 0.0;  ///< kt [N/m] of the whole face
   double friction_coefficient = 0.0;
-  double frame_angle = 0.0;          ///< [rad], as contact.frame_angle_deg
+  double frame_angle = 0.0;  ///< [rad], as contact.frame_angle_deg
 };
 
 struct StaticShroud {
-  std::vector<ShroudFaceNode> face;                     ///< one element per face pair
+  std::vector<ShroudFaceNode> face;  ///< one element per face pair
   /// One per face pair (face_springs): nodes, frame and stiffness; tied, they are the
   /// linear model's springs of the closed pairs (modal.shroud = "contact").
   std::vector<cyclic::InterfaceSpring> springs;
   std::vector<contact::StaticPairParameters> parameters;  ///< the springs' kn, kt, with mu and delta
-  std::vector<contact::StaticPairResult> results;       ///< at the final speed
-  Eigen::VectorXd displacement;                         ///< all 3 n_nodes sector DOFs [m]
+  std::vector<contact::StaticPairResult> results;         ///< at the final speed
+  Eigen::VectorXd displacement;                           ///< all 3 n_nodes sector DOFs [m]
   int increments = 0, newton_iterations = 0;
   double seconds = 0.0;
   /// Totals over the face [N] and counts of the states.
@@ -90,7 +90,6 @@ StaticShroud solve_static_shroud(const mesh::Mesh& mesh, const linalg::SparsePai
 /// loads, an open pair counting as -kn_i gap_i (a fully open patch then has the area-weighted
 /// mean gap); the patches' members index the face, listed in the static solve's order.
 std::vector<contact::PairParameters> patch_parameters(const std::vector<ContactPatch>& patches, double face_area,
-                                                      const contact::PairParameters& face,
-                                                      const StaticShroud* state);
+                                                      const contact::PairParameters& face, const StaticShroud* state);
 
 }  // namespace shroudsim::frf

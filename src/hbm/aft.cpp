@@ -31,12 +31,11 @@ Aft::Workspace::~Workspace() {
 
 Aft::Aft(int n_harmonics, AftOptions options) : n_harmonics_(n_harmonics), n_(options.n_time_samples) {
   if (n_harmonics < 0)
-    throw std::invalid_argument("Aft: harmonics = " + std::to_string(n_harmonics) +
-                                " violates: harmonics >= 0");
+    throw std::invalid_argument("Aft: harmonics = " + std::to_string(n_harmonics) + " violates: harmonics >= 0");
   if (n_ < 2 * n_harmonics + 1)
     throw std::invalid_argument("Aft: time_samples = " + std::to_string(n_) +
-                                " violates: time_samples >= 2*harmonics+1 (= " +
-                                std::to_string(2 * n_harmonics + 1) + ")");
+                                " violates: time_samples >= 2*harmonics+1 (= " + std::to_string(2 * n_harmonics + 1) +
+                                ")");
   {
     const std::lock_guard<std::mutex> lock(planner_mutex());
     Workspace ws(n_);
@@ -78,8 +77,7 @@ void Aft::to_time(const double* coeffs, double* samples, Workspace& ws) const {
     s[2 * k] = 0.5 * coeffs[2 * k - 1];
     s[2 * k + 1] = -0.5 * coeffs[2 * k];
   }
-  fftw_execute_dft_c2r(static_cast<fftw_plan>(plan_c2r_), reinterpret_cast<fftw_complex*>(s),
-                       ws.real());
+  fftw_execute_dft_c2r(static_cast<fftw_plan>(plan_c2r_), reinterpret_cast<fftw_complex*>(s), ws.real());
   for (int l = 0; l < n_; ++l) samples[l] = ws.real()[l];
 }
 
@@ -96,8 +94,7 @@ void Aft::to_harmonics(const double* samples, double* coeffs, Workspace& ws) con
   }
 }
 
-void Aft::weighted_gram(const double* weights, Eigen::Ref<Eigen::MatrixXd> gram,
-                        Workspace& ws) const {
+void Aft::weighted_gram(const double* weights, Eigen::Ref<Eigen::MatrixXd> gram, Workspace& ws) const {
   double* r = ws.real();
   for (int l = 0; l < n_; ++l) r[l] = weights[l];
   double* s = ws.spectrum();
@@ -122,14 +119,10 @@ void Aft::weighted_gram(const double* weights, Eigen::Ref<Eigen::MatrixXd> gram,
       const int b = (j + 1) / 2;
       const bool jsin = j > 0 && j % 2 == 0;
       double v;
-      if (!ksin && !jsin)
-        v = 0.5 * (re(a - b) + re(a + b));
-      else if (ksin && jsin)
-        v = 0.5 * (re(a - b) - re(a + b));
-      else if (ksin)
-        v = 0.5 * (sn(a + b) + sn(a - b));
-      else
-        v = 0.5 * (sn(a + b) - sn(a - b));
+      if (!ksin && !jsin) v = 0.5 * (re(a - b) + re(a + b));
+      else if (ksin && jsin) v = 0.5 * (re(a - b) - re(a + b));
+      else if (ksin) v = 0.5 * (sn(a + b) + sn(a - b));
+      else v = 0.5 * (sn(a + b) - sn(a - b));
       gram(k, j) = wk * v;
     }
   }

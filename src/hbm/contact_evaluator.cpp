@@ -30,8 +30,7 @@ bool ContactEvaluatorOptions::validate(std::vector<std::string>* errors) const {
     valid = false;
     if (errors) errors->push_back(m);
   };
-  if (n_harmonics < 0)
-    fail("harmonics = " + std::to_string(n_harmonics) + " violates: harmonics >= 0");
+  if (n_harmonics < 0) fail("harmonics = " + std::to_string(n_harmonics) + " violates: harmonics >= 0");
   if (law.model == contact::Model::one_d_exact) {
     if (n_harmonics != 1)
       fail("harmonics = " + std::to_string(n_harmonics) +
@@ -65,8 +64,7 @@ struct ContactEvaluator::Workspace {
   Eigen::VectorXd wp, fp, fm;
 };
 
-ContactEvaluator::ContactEvaluator(const ContactEvaluatorOptions& options,
-                                   std::vector<contact::PairParameters> pairs)
+ContactEvaluator::ContactEvaluator(const ContactEvaluatorOptions& options, std::vector<contact::PairParameters> pairs)
     : options_(options),
       pairs_(std::move(pairs)),
       layout_(std::max(options.n_harmonics, 0), contact::n_directions(options.law.model)) {
@@ -88,8 +86,7 @@ ContactEvaluator::ContactEvaluator(const ContactEvaluatorOptions& options,
   threads = std::max(1, std::min<int>(threads, std::max<int>(1, static_cast<int>(pairs_.size()))));
   contact::LawOptions law = options_.law;
   if (closed_form) law.model = contact::Model::one_d;  // the time law is unused then
-  for (int t = 0; t < threads; ++t)
-    workspaces_.push_back(std::make_unique<Workspace>(n, layout_.size(), law));
+  for (int t = 0; t < threads; ++t) workspaces_.push_back(std::make_unique<Workspace>(n, layout_.size(), law));
 }
 
 ContactEvaluator::~ContactEvaluator() = default;
@@ -100,13 +97,11 @@ void ContactEvaluator::to_time(const double* w, Workspace& ws) {
   for (int j = 0; j < layout_.n_directions(); ++j) aft_->to_time(w + j * m, ws.w.col(j).data(), ws.fft);
 }
 
-contact::PeriodicStatus ContactEvaluator::residual(int pair, const double* w, double* f,
-                                                   Workspace& ws) {
+contact::PeriodicStatus ContactEvaluator::residual(int pair, const double* w, double* f, Workspace& ws) {
   const contact::PairParameters& pp = pairs_[pair];
   if (options_.law.model == contact::Model::one_d_exact) {
     const auto h = contact::jenkins_single_harmonic(pp.tangential_stiffness,
-                                                    pp.friction_coefficient * pp.normal_preload,
-                                                    w[0], w[1], w[2]);
+                                                    pp.friction_coefficient * pp.normal_preload, w[0], w[1], w[2]);
     f[0] = h.f0;
     f[1] = h.fc;
     f[2] = h.fs;
@@ -119,15 +114,14 @@ contact::PeriodicStatus ContactEvaluator::residual(int pair, const double* w, do
   return status;
 }
 
-contact::PeriodicStatus ContactEvaluator::analytic(int pair, const double* w, double* f,
-                                                   Eigen::MatrixXd& jac, Workspace& ws) {
+contact::PeriodicStatus ContactEvaluator::analytic(int pair, const double* w, double* f, Eigen::MatrixXd& jac,
+                                                   Workspace& ws) {
   const contact::PairParameters& pp = pairs_[pair];
   const int s = layout_.size();
   jac.resize(s, s);
   if (options_.law.model == contact::Model::one_d_exact) {
     const auto h = contact::jenkins_single_harmonic(pp.tangential_stiffness,
-                                                    pp.friction_coefficient * pp.normal_preload,
-                                                    w[0], w[1], w[2]);
+                                                    pp.friction_coefficient * pp.normal_preload, w[0], w[1], w[2]);
     f[0] = h.f0;
     f[1] = h.fc;
     f[2] = h.fs;
@@ -210,8 +204,8 @@ double ContactEvaluator::fd_step(int pair, const double* w, int coefficient) con
   return options_.fd_relative_step * scale;
 }
 
-contact::PeriodicStatus ContactEvaluator::finite_difference(int pair, const double* w, double* f,
-                                                            Eigen::MatrixXd& jac, Workspace& ws) {
+contact::PeriodicStatus ContactEvaluator::finite_difference(int pair, const double* w, double* f, Eigen::MatrixXd& jac,
+                                                            Workspace& ws) {
   const int s = layout_.size();
   jac.resize(s, s);
   const auto status = residual(pair, w, f, ws);
@@ -235,8 +229,7 @@ EvaluationStatus ContactEvaluator::evaluate(const Eigen::VectorXd& w, Eigen::Vec
 }
 
 EvaluationStatus ContactEvaluator::evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f,
-                                            std::vector<Eigen::MatrixXd>* jacobian,
-                                            JacobianMethod method) {
+                                            std::vector<Eigen::MatrixXd>* jacobian, JacobianMethod method) {
   SHROUDSIM_CHECK(w.size() == size(), "ContactEvaluator::evaluate: w has the wrong size");
   if (!w.allFinite()) throw std::invalid_argument("ContactEvaluator::evaluate: non-finite W");
   f.resize(size());
@@ -268,12 +261,9 @@ EvaluationStatus ContactEvaluator::evaluate(const Eigen::VectorXd& w, Eigen::Vec
   auto one = [&](int p, Workspace& ws) {
     const double* wp = w.data() + static_cast<std::ptrdiff_t>(p) * s;
     double* fp = f.data() + static_cast<std::ptrdiff_t>(p) * s;
-    if (!jacobian)
-      st[p] = residual(p, wp, fp, ws);
-    else if (method == JacobianMethod::analytic)
-      st[p] = analytic(p, wp, fp, (*jacobian)[p], ws);
-    else
-      st[p] = finite_difference(p, wp, fp, (*jacobian)[p], ws);
+    if (!jacobian) st[p] = residual(p, wp, fp, ws);
+    else if (method == JacobianMethod::analytic) st[p] = analytic(p, wp, fp, (*jacobian)[p], ws);
+    else st[p] = finite_difference(p, wp, fp, (*jacobian)[p], ws);
   };
   const int threads = static_cast<int>(workspaces_.size());
   if (threads <= 1 || np <= 1) {
@@ -302,8 +292,7 @@ EvaluationStatus ContactEvaluator::evaluate(const Eigen::VectorXd& w, Eigen::Vec
   return out;
 }
 
-void ContactEvaluator::evaluate_pair(int pair, const Eigen::VectorXd& w_pair, PairDetail& d,
-                                     bool with_jacobian) {
+void ContactEvaluator::evaluate_pair(int pair, const Eigen::VectorXd& w_pair, PairDetail& d, bool with_jacobian) {
   SHROUDSIM_CHECK(pair >= 0 && pair < n_pairs(), "evaluate_pair: no such pair");
   SHROUDSIM_CHECK(w_pair.size() == layout_.size(), "evaluate_pair: w has the wrong size");
   if (!w_pair.allFinite()) throw std::invalid_argument("ContactEvaluator::evaluate_pair: non-finite W");
@@ -326,9 +315,8 @@ void ContactEvaluator::evaluate_pair(int pair, const Eigen::VectorXd& w_pair, Pa
     for (int l = 0; l < n; ++l) {
       const double th = 2.0 * std::numbers::pi * l / n;
       d.w(l, 0) = w_pair[0] + w_pair[1] * std::cos(th) + w_pair[2] * std::sin(th);
-      d.f(l, 0) = contact::jenkins_force(pp.tangential_stiffness,
-                                         pp.friction_coefficient * pp.normal_preload, w_pair[0],
-                                         w_pair[1], w_pair[2], th);
+      d.f(l, 0) = contact::jenkins_force(pp.tangential_stiffness, pp.friction_coefficient * pp.normal_preload,
+                                         w_pair[0], w_pair[1], w_pair[2], th);
     }
     return;
   }
@@ -339,8 +327,7 @@ void ContactEvaluator::evaluate_pair(int pair, const Eigen::VectorXd& w_pair, Pa
   d.f = ws.f;
 }
 
-double dissipated_energy(const HarmonicLayout& layout, const Eigen::VectorXd& w,
-                         const Eigen::VectorXd& f) {
+double dissipated_energy(const HarmonicLayout& layout, const Eigen::VectorXd& w, const Eigen::VectorXd& f) {
   SHROUDSIM_CHECK(w.size() == layout.size() && f.size() == layout.size(), "dissipated_energy sizes");
   double e = 0.0;
   const int m = layout.per_direction();

@@ -44,13 +44,13 @@ enum class JacobianMethod {
 std::string to_string(JacobianMethod method);
 
 struct ContactEvaluatorOptions {
-  int n_harmonics = 5;          ///< H >= 0 (1d_exact: H = 1)
-  int n_time_samples = 512;     ///< N >= 2H+1 (not used by 1d_exact)
-  contact::LawOptions law;      ///< model, tangential update, steady-state iteration
+  int n_harmonics = 5;       ///< H >= 0 (1d_exact: H = 1)
+  int n_time_samples = 512;  ///< N >= 2H+1 (not used by 1d_exact)
+  contact::LawOptions law;   ///< model, tangential update, steady-state iteration
   JacobianMethod jacobian = JacobianMethod::analytic;
   double fd_relative_step = 1e-6;  ///< central-difference step / max|W_pair| (see fd_step)
-  int threads = 0;              ///< 0: OpenMP default, 1: serial
-  bool measure_plans = true;    ///< FFTW_MEASURE planning
+  int threads = 0;                 ///< 0: OpenMP default, 1: serial
+  bool measure_plans = true;       ///< FFTW_MEASURE planning
 
   /// One message per violated constraint, keys named as in docs/contract.md where they map.
   bool validate(std::vector<std::string>* errors) const;
@@ -73,8 +73,7 @@ struct PairDetail {
 class ContactEvaluator {
  public:
   /// Throws std::invalid_argument with the violated constraint on bad options or pairs.
-  ContactEvaluator(const ContactEvaluatorOptions& options,
-                   std::vector<contact::PairParameters> pairs);
+  ContactEvaluator(const ContactEvaluatorOptions& options, std::vector<contact::PairParameters> pairs);
   ~ContactEvaluator();
   ContactEvaluator(const ContactEvaluator&) = delete;
   ContactEvaluator& operator=(const ContactEvaluator&) = delete;
@@ -87,15 +86,13 @@ class ContactEvaluator {
 
   /// f = F(w); when jacobian != nullptr also the per-pair blocks dF_p/dW_p (method of the
   /// options). Sizes are checked (std::logic_error). Non-finite w -> std::invalid_argument.
-  EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f,
-                            std::vector<Eigen::MatrixXd>* jacobian);
+  EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f, std::vector<Eigen::MatrixXd>* jacobian);
   /// The same with an explicit Jacobian method (comparisons and benchmarks).
-  EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f,
-                            std::vector<Eigen::MatrixXd>* jacobian, JacobianMethod method);
+  EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f, std::vector<Eigen::MatrixXd>* jacobian,
+                            JacobianMethod method);
 
   /// One pair (coefficients w_pair of pair_layout().size()) with its time histories.
-  void evaluate_pair(int pair, const Eigen::VectorXd& w_pair, PairDetail& detail,
-                     bool with_jacobian);
+  void evaluate_pair(int pair, const Eigen::VectorXd& w_pair, PairDetail& detail, bool with_jacobian);
 
   /// The central-difference step for one coefficient of a pair [m]: fd_relative_step times
   /// the largest coefficient of the same direction (directions may differ by many orders of
@@ -106,22 +103,19 @@ class ContactEvaluator {
  private:
   struct Workspace;
   contact::PeriodicStatus residual(int pair, const double* w, double* f, Workspace& ws);
-  contact::PeriodicStatus analytic(int pair, const double* w, double* f, Eigen::MatrixXd& jac,
-                                   Workspace& ws);
-  contact::PeriodicStatus finite_difference(int pair, const double* w, double* f,
-                                            Eigen::MatrixXd& jac, Workspace& ws);
+  contact::PeriodicStatus analytic(int pair, const double* w, double* f, Eigen::MatrixXd& jac, Workspace& ws);
+  contact::PeriodicStatus finite_difference(int pair, const double* w, double* f, Eigen::MatrixXd& jac, Workspace& ws);
   void to_time(const double* w, Workspace& ws);
 
   ContactEvaluatorOptions options_;
   std::vector<contact::PairParameters> pairs_;
   HarmonicLayout layout_;
-  std::unique_ptr<Aft> aft_;  // null for 1d_exact
+  std::unique_ptr<Aft> aft_;                            // null for 1d_exact
   std::vector<std::unique_ptr<Workspace>> workspaces_;  // one per thread
 };
 
 /// Energy dissipated per cycle by the force F on the motion W [J]: the loop integral
 /// sum over directions of  integral F dw = sum_n pi n (Fc_n s_n - Fs_n c_n).
-double dissipated_energy(const HarmonicLayout& layout, const Eigen::VectorXd& w,
-                         const Eigen::VectorXd& f);
+double dissipated_energy(const HarmonicLayout& layout, const Eigen::VectorXd& w, const Eigen::VectorXd& f);
 
 }  // namespace shroudsim::hbm

@@ -16,8 +16,8 @@ class HarmonicLayout {
 
   HarmonicLayout(int n_harmonics, int n_directions);
 
-  int n_harmonics() const { return n_harmonics_; }      ///< H
-  int n_directions() const { return n_directions_; }    ///< directions per block set
+  int n_harmonics() const { return n_harmonics_; }    ///< H
+  int n_directions() const { return n_directions_; }  ///< directions per block set
   int per_direction() const { return 2 * n_harmonics_ + 1; }
   int size() const { return n_directions_ * per_direction(); }
 

@@ -1,10 +1,10 @@
 #include "io/case.hpp"
 
+#include <toml++/toml.h>
 #include <algorithm>
 #include <fstream>
 #include <map>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "core/error.hpp"
 #include "io/case_reader.hpp"
@@ -121,7 +121,8 @@ Case parse_case(const std::string& text, const fs::path& file, const std::vector
       const std::string section = key.substr(0, dot);
       if (!root.contains(section)) root.insert(section, toml::table{});
       target = root[section].as_table();
-      if (!target) throw InputError(file.string() + ": --set " + o + ": [" + section + "] is not a table in the case file");
+      if (!target)
+        throw InputError(file.string() + ": --set " + o + ": [" + section + "] is not a table in the case file");
     }
     target->insert_or_assign(key.substr(dot == std::string::npos ? 0 : dot + 1), *v.node());
     overridden[key] = value;

@@ -31,9 +31,9 @@ std::string to_string(ModalShroud shroud);  ///< "open", "stuck", "contact"
 // The members below get their defaults from the schema (Case's constructor), not here.
 
 struct StructureSection {
-  StructureType type;                   ///< FE sector or lumped M, K, C
-  int sectors;                          ///< Nb >= 1
-  std::filesystem::path mesh;           ///< absolute path of a given mesh, empty: generate
+  StructureType type;                        ///< FE sector or lumped M, K, C
+  int sectors;                               ///< Nb >= 1
+  std::filesystem::path mesh;                ///< absolute path of a given mesh, empty: generate
   Eigen::MatrixXd mass, stiffness, damping;  ///< lumped only, n x n (damping may be empty)
 };
 
@@ -50,7 +50,7 @@ struct GeometrySection {
   double shroud_contact_angle_deg;
   int element_order;
   double mesh_size;
-  double max_elements;                  ///< refuse to mesh when the estimated element count is larger
+  double max_elements;  ///< refuse to mesh when the estimated element count is larger
 };
 
 struct MaterialSection {
@@ -61,16 +61,16 @@ struct MaterialSection {
 
 struct ModalSection {
   int modes;
-  bool all_harmonic_indices;            ///< harmonic_indices = "all"
-  std::vector<int> harmonic_indices;    ///< when not all: sorted, without repeats
+  bool all_harmonic_indices;          ///< harmonic_indices = "all"
+  std::vector<int> harmonic_indices;  ///< when not all: sorted, without repeats
   double damping_ratio;
   bool residual_flexibility;
-  modal::EigenMethod eigensolver;       ///< block Krylov-Schur or Spectra's Lanczos
+  modal::EigenMethod eigensolver;  ///< block Krylov-Schur or Spectra's Lanczos
   ModalShroud shroud;
 };
 
 struct CampbellSection {
-  std::vector<double> speed_rpm;        ///< [min, max]
+  std::vector<double> speed_rpm;  ///< [min, max]
   int speed_points;
   std::vector<int> engine_orders;
   bool rotating_effects;
@@ -83,57 +83,57 @@ struct StaticSection {
 
 struct ExcitationSection {
   int engine_order;
-  std::array<double, 3> point;          ///< sector: nearest node
-  std::array<double, 3> force;          ///< N; lumped: force[0] only
-  int dof;                              ///< lumped only
+  std::array<double, 3> point;  ///< sector: nearest node
+  std::array<double, 3> force;  ///< N; lumped: force[0] only
+  int dof;                      ///< lumped only
   double speed_rpm;
 };
 
 struct ResponseSection {
   std::array<double, 3> point;
-  int dof;                              ///< lumped only
+  int dof;  ///< lumped only
 };
 
 /// A lumped contact element: one DOF per direction (-1: absent), to ground or to other DOFs.
 struct ContactElement {
   int x_dof = -1, y_dof = -1, z_dof = -1;
   int other_x_dof = -1, other_y_dof = -1, other_z_dof = -1;  ///< -1: ground
-  std::optional<double> friction_coefficient, normal_stiffness, tangential_stiffness,
-      normal_preload, frame_angle_deg;  ///< unset: the [contact] value
+  std::optional<double> friction_coefficient, normal_stiffness, tangential_stiffness, normal_preload,
+      frame_angle_deg;  ///< unset: the [contact] value
 };
 
 struct ContactSection {
   contact::Model model;
-  int pairs;                            ///< 0: "all"
+  int pairs;                                  ///< 0: "all"
   frf::ContactDiscretization discretization;  ///< sector only
   double friction_coefficient;
-  double normal_stiffness;              ///< N/m per interface
-  double tangential_stiffness;          ///< N/m per interface
-  double normal_preload;                ///< N per interface, < 0: gap
-  bool normal_preload_static;           ///< "static": each patch's from the static shroud contact at excitation.speed_rpm
+  double normal_stiffness;      ///< N/m per interface
+  double tangential_stiffness;  ///< N/m per interface
+  double normal_preload;        ///< N per interface, < 0: gap
+  bool normal_preload_static;   ///< "static": each patch's from the static shroud contact at excitation.speed_rpm
   double frame_angle_deg;
-  double interference;                  ///< sector: overlap of the shroud faces at rest [m]; < 0: a gap
+  double interference;  ///< sector: overlap of the shroud faces at rest [m]; < 0: a gap
   contact::TangentialUpdate tangential_update;
-  std::vector<ContactElement> elements; ///< lumped only
+  std::vector<ContactElement> elements;  ///< lumped only
 };
 
 struct HbmSection {
-  int harmonics;                        ///< H (0 with harmonics_auto)
+  int harmonics;  ///< H (0 with harmonics_auto)
   bool harmonics_auto;
-  int time_samples;                     ///< N (0 with time_samples_auto)
+  int time_samples;  ///< N (0 with time_samples_auto)
   bool time_samples_auto;
   hbm::JacobianMethod jacobian;
   double tolerance;
-  double energy_tolerance;              ///< energy-balance error above which a point fails the run
-  double auto_tolerance;                ///< "auto": relative change of the peak amplitude to stop at
-  int auto_max_harmonics;               ///< "auto": largest H tried
-  int auto_max_time_samples;            ///< "auto": largest N tried
+  double energy_tolerance;    ///< energy-balance error above which a point fails the run
+  double auto_tolerance;      ///< "auto": relative change of the peak amplitude to stop at
+  int auto_max_harmonics;     ///< "auto": largest H tried
+  int auto_max_time_samples;  ///< "auto": largest N tried
 };
 
 struct ContinuationSection {
   double frequency_start_hz;
   double frequency_end_hz;
-  double initial_step;                  ///< Hz-equivalent arclength; 0: "auto" (docs/continuation.md)
+  double initial_step;  ///< Hz-equivalent arclength; 0: "auto" (docs/continuation.md)
   int max_points;
 };
 
@@ -156,14 +156,14 @@ struct StudySection {
 struct Case {
   Case();
   std::string name;
-  std::filesystem::path file;            ///< the case file (absolute)
-  std::filesystem::path directory;       ///< its folder: relative paths resolve here
+  std::filesystem::path file;       ///< the case file (absolute)
+  std::filesystem::path directory;  ///< its folder: relative paths resolve here
   StructureSection structure;
   GeometrySection geometry;
   MaterialSection material;
   ModalSection modal;
   CampbellSection campbell;
-  StaticSection static_contact;          ///< [static]
+  StaticSection static_contact;  ///< [static]
   ExcitationSection excitation;
   ResponseSection response;
   ContactSection contact;

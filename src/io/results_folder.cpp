@@ -36,16 +36,16 @@ ResultsFolder::ResultsFolder(fs::path target, const std::string& option) {
   target_ = target;
   const std::string where = option + " " + target_.string();
   const std::string leaf = target_.filename().string();
-  if (leaf.empty() || leaf == "." || leaf == "..")
-    throw InputError(where + ": not a folder name a run can write");
+  if (leaf.empty() || leaf == "." || leaf == "..") throw InputError(where + ": not a folder name a run can write");
   if (leaf.size() > kMaxLeaf)
     throw InputError(where + ": the folder name has " + std::to_string(leaf.size()) + " characters (at most " +
                      std::to_string(kMaxLeaf) + "; a case's name is the default folder name)");
   if (fs::exists(target_, ec) && !fs::is_directory(target_, ec))
     throw InputError(where + ": exists and is not a folder");
   if (fs::is_directory(target_, ec) && !is_results_folder(target_))
-    throw InputError(where + ": exists and is not a results folder (no run.json, not empty); a run replaces its "
-                             "whole folder: choose another folder");
+    throw InputError(where +
+                     ": exists and is not a results folder (no run.json, not empty); a run replaces its "
+                     "whole folder: choose another folder");
   const fs::path parent = target_.parent_path();
   fs::create_directories(parent, ec);
   if (ec || !fs::is_directory(parent) || ::access(parent.c_str(), W_OK | X_OK) != 0)
@@ -54,12 +54,14 @@ ResultsFolder::ResultsFolder(fs::path target, const std::string& option) {
 
   const fs::path lock = parent / ("." + leaf + ".lock");
   lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (lock_fd_ < 0) throw InputError(where + ": cannot create the lock file " + lock.string() + ": " + std::strerror(errno));
+  if (lock_fd_ < 0)
+    throw InputError(where + ": cannot create the lock file " + lock.string() + ": " + std::strerror(errno));
   if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
     ::close(lock_fd_);
     lock_fd_ = -1;
-    throw InputError(where + ": another shroudsim run is writing this results folder; wait for it to finish or "
-                             "choose another folder");
+    throw InputError(where +
+                     ": another shroudsim run is writing this results folder; wait for it to finish or "
+                     "choose another folder");
   }
   // Holding the lock, any staging folder of this target is a killed run's: remove it.
   for (const auto& e : fs::directory_iterator(parent, ec)) {

@@ -51,11 +51,12 @@ VtuBuilder::VtuBuilder(const mesh::Mesh& mesh) : mesh_(mesh) {
 }
 
 void VtuBuilder::add(const std::string& name, const std::vector<float>& values, int components) {
-  SHROUDSIM_CHECK((components == 1 || components == 3) &&
-                      values.size() == static_cast<std::size_t>(mesh_.n_nodes()) * components,
-                  "VtuBuilder::add: a field needs n_nodes * (1 or 3) values");
+  SHROUDSIM_CHECK(
+      (components == 1 || components == 3) && values.size() == static_cast<std::size_t>(mesh_.n_nodes()) * components,
+      "VtuBuilder::add: a field needs n_nodes * (1 or 3) values");
   s_ << "<DataArray type=\"Float32\" Name=\"" << name << "\" NumberOfComponents=\"" << components
-     << "\" format=\"binary\">\n" << vtk_binary(values) << "\n</DataArray>\n";
+     << "\" format=\"binary\">\n"
+     << vtk_binary(values) << "\n</DataArray>\n";
 }
 
 std::string VtuBuilder::finish() {
@@ -73,9 +74,12 @@ std::string VtuBuilder::finish() {
     offsets.push_back(static_cast<std::int32_t>(conn.size()));
     types.push_back(npe == 10 ? 24 : 10);
   }
-  s_ << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"binary\">\n" << vtk_binary(conn) << "\n</DataArray>\n"
-     << "<DataArray type=\"Int32\" Name=\"offsets\" format=\"binary\">\n" << vtk_binary(offsets) << "\n</DataArray>\n"
-     << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n" << vtk_binary(types) << "\n</DataArray>\n"
+  s_ << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"binary\">\n"
+     << vtk_binary(conn) << "\n</DataArray>\n"
+     << "<DataArray type=\"Int32\" Name=\"offsets\" format=\"binary\">\n"
+     << vtk_binary(offsets) << "\n</DataArray>\n"
+     << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n"
+     << vtk_binary(types) << "\n</DataArray>\n"
      << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
   return s_.str();
 }

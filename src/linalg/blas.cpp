@@ -10,9 +10,8 @@ extern "C" {
 void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const double* alpha,
             const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
             const int* ldc);
-void zgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const void* alpha,
-            const void* a, const int* lda, const void* b, const int* ldb, const void* beta, void* c,
-            const int* ldc);
+void zgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const void* alpha, const void* a,
+            const int* lda, const void* b, const int* ldb, const void* beta, void* c, const int* ldc);
 }
 
 namespace shroudsim::linalg {
@@ -37,8 +36,7 @@ void gemm(Op op_a, Scalar alpha, const Eigen::Ref<const DenseMatrix<Scalar>, 0, 
   const char ta = adj ? 'C' : 'N', tb = 'N';
   if constexpr (std::is_same_v<Scalar, double>)
     dgemm_(&ta, &tb, &im, &in, &ik, &alpha, A.data(), &lda, B.data(), &ldb, &beta, C.data(), &ldc);
-  else
-    zgemm_(&ta, &tb, &im, &in, &ik, &alpha, A.data(), &lda, B.data(), &ldb, &beta, C.data(), &ldc);
+  else zgemm_(&ta, &tb, &im, &in, &ik, &alpha, A.data(), &lda, B.data(), &ldb, &beta, C.data(), &ldc);
 }
 
 template void gemm<double>(Op, double, const Eigen::Ref<const DenseMatrix<double>, 0, Eigen::OuterStride<>>&,

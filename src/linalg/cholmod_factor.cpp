@@ -56,10 +56,9 @@ struct CholmodFactor<Scalar>::Impl {
 
 template <typename Scalar>
 CholmodFactor<Scalar>::CholmodFactor(FactorMethod method) : impl_(std::make_unique<Impl>()) {
-  impl_->llt.setMode(method == FactorMethod::Supernodal ? Eigen::CholmodSupernodalLLt
-                                                        : Eigen::CholmodSimplicialLLt);
+  impl_->llt.setMode(method == FactorMethod::Supernodal ? Eigen::CholmodSupernodalLLt : Eigen::CholmodSimplicialLLt);
   cholmod_common& c = impl_->llt.cholmod();
-  c.print = 0;                         // failures are reported through status(), not stderr
+  c.print = 0;  // failures are reported through status(), not stderr
   c.quick_return_if_not_posdef = 1;
 }
 

@@ -16,10 +16,8 @@ DenseMatrix<Scalar> deterministic_block(Eigen::Index n, Eigen::Index b) {
   DenseMatrix<Scalar> X(n, b);
   for (Eigen::Index j = 0; j < b; ++j)
     for (Eigen::Index i = 0; i < n; ++i) {
-      if constexpr (!std::is_same_v<Scalar, double>)
-        X(i, j) = Scalar(u(gen), u(gen));
-      else
-        X(i, j) = u(gen);
+      if constexpr (!std::is_same_v<Scalar, double>) X(i, j) = Scalar(u(gen), u(gen));
+      else X(i, j) = u(gen);
     }
   return X;
 }

@@ -70,8 +70,8 @@ class PointGrid {
     return ((x - origin_) / cell_).array().floor().cast<int>().transpose();
   }
   static long long key(const Eigen::Vector3i& c) {
-    return (static_cast<long long>(c.x() & 0x1FFFFF) << 42) |
-           (static_cast<long long>(c.y() & 0x1FFFFF) << 21) | static_cast<long long>(c.z() & 0x1FFFFF);
+    return (static_cast<long long>(c.x() & 0x1FFFFF) << 42) | (static_cast<long long>(c.y() & 0x1FFFFF) << 21) |
+           static_cast<long long>(c.z() & 0x1FFFFF);
   }
   const NodeMatrix& nodes_;
   const std::vector<int>& ids_;
@@ -83,8 +83,8 @@ class PointGrid {
 
 }  // namespace
 
-NodeMatch match_rotated_nodes(const NodeMatrix& nodes, const std::vector<int>& low,
-                              const std::vector<int>& high, double angle, double tolerance) {
+NodeMatch match_rotated_nodes(const NodeMatrix& nodes, const std::vector<int>& low, const std::vector<int>& high,
+                              double angle, double tolerance) {
   NodeMatch m;
   const Eigen::Matrix3d r = rotation_z(angle);
   const PointGrid grid(nodes, high);
@@ -107,8 +107,7 @@ NodeMatch match_rotated_nodes(const NodeMatrix& nodes, const std::vector<int>& l
       m.worst_high = q;
     }
   }
-  m.complete = one_to_one && low.size() == high.size() && !low.empty() &&
-               m.worst_distance <= tolerance;
+  m.complete = one_to_one && low.size() == high.size() && !low.empty() && m.worst_distance <= tolerance;
   return m;
 }
 
@@ -204,9 +203,9 @@ QualityStats element_quality(const Mesh& mesh) {
 std::string describe(const QualityStats& q) {
   std::ostringstream s;
   s.precision(3);
-  s << "quality (mean ratio) min " << q.min_mean_ratio << " mean " << q.mean_mean_ratio << ", "
-    << q.below_0_1 << " below 0.1; min detJ ratio " << q.min_jacobian_ratio << "; inverted "
-    << q.inverted << ", degenerate " << q.degenerate;
+  s << "quality (mean ratio) min " << q.min_mean_ratio << " mean " << q.mean_mean_ratio << ", " << q.below_0_1
+    << " below 0.1; min detJ ratio " << q.min_jacobian_ratio << "; inverted " << q.inverted << ", degenerate "
+    << q.degenerate;
   return s.str();
 }
 

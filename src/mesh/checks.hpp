@@ -22,21 +22,21 @@ struct NodeMatch {
 
 /// Matches each low node to its nearest high node after rotating it by `angle` about z.
 /// Complete when |low| == |high|, the map is one-to-one and every distance <= tolerance.
-NodeMatch match_rotated_nodes(const NodeMatrix& nodes, const std::vector<int>& low,
-                              const std::vector<int>& high, double angle, double tolerance);
+NodeMatch match_rotated_nodes(const NodeMatrix& nodes, const std::vector<int>& low, const std::vector<int>& high,
+                              double angle, double tolerance);
 
 /// Diagonal of the bounding box of all nodes (m): the model size used for tolerances.
 double model_size(const NodeMatrix& nodes);
 
 /// Quality statistics of the tetrahedra.
 struct QualityStats {
-  double min_mean_ratio = 1.0;   ///< mean-ratio quality in (0, 1], 1 = regular; of the corners
+  double min_mean_ratio = 1.0;  ///< mean-ratio quality in (0, 1], 1 = regular; of the corners
   double mean_mean_ratio = 1.0;
-  int below_0_1 = 0;             ///< elements with mean ratio < 0.1
+  int below_0_1 = 0;                ///< elements with mean ratio < 0.1
   double min_jacobian_ratio = 1.0;  ///< min over elements of min/max det J at sample points
-  int inverted = 0;              ///< elements with det J <= 0 at some sample point
-  int degenerate = 0;            ///< elements with a volume below 1e-12 of the mean volume
-  double volume = 0.0;           ///< total volume (m^3)
+  int inverted = 0;                 ///< elements with det J <= 0 at some sample point
+  int degenerate = 0;               ///< elements with a volume below 1e-12 of the mean volume
+  double volume = 0.0;              ///< total volume (m^3)
 };
 
 /// Corner mean ratio, Jacobian sign at the vertices, edge midpoints and centroid

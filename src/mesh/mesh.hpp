@@ -31,14 +31,14 @@ inline constexpr const char* kShroudHigh = "shroud_high";
 inline constexpr const char* kSector = "sector";
 
 struct Mesh {
-  NodeMatrix nodes;                 ///< n_nodes x 3, metres
-  ConnectivityMatrix tets;          ///< n_elements x (4 | 10), 0-based node indices
-  int element_order = 2;            ///< 1 (4-node) or 2 (10-node)
-  int sectors = 0;                  ///< Nb, the number of sectors of the wheel
-  std::map<std::string, std::vector<int>> node_sets;                ///< sorted node indices
-  std::map<std::string, ConnectivityMatrix> surface_triangles;      ///< per 2D group
-  std::vector<std::pair<int, int>> cyclic_pairs;  ///< (cyclic_low p, cyclic_high q), q = R p
-  std::vector<std::pair<int, int>> shroud_pairs;  ///< (shroud_low p, shroud_high q), q = R p
+  NodeMatrix nodes;                                             ///< n_nodes x 3, metres
+  ConnectivityMatrix tets;                                      ///< n_elements x (4 | 10), 0-based node indices
+  int element_order = 2;                                        ///< 1 (4-node) or 2 (10-node)
+  int sectors = 0;                                              ///< Nb, the number of sectors of the wheel
+  std::map<std::string, std::vector<int>> node_sets;            ///< sorted node indices
+  std::map<std::string, ConnectivityMatrix> surface_triangles;  ///< per 2D group
+  std::vector<std::pair<int, int>> cyclic_pairs;                ///< (cyclic_low p, cyclic_high q), q = R p
+  std::vector<std::pair<int, int>> shroud_pairs;                ///< (shroud_low p, shroud_high q), q = R p
 
   int n_nodes() const { return static_cast<int>(nodes.rows()); }
   int n_elements() const { return static_cast<int>(tets.rows()); }

@@ -196,8 +196,7 @@ Mesh read_sector_mesh(const std::filesystem::path& file, const ReadOptions& opti
           for (std::size_t tag : elem_nodes[t]) {
             auto n = index.find(tag);
             if (n == index.end())
-              fail(file, std::string("surface group '") + name +
-                             "' has a node that no tetrahedron uses (node tag " +
+              fail(file, std::string("surface group '") + name + "' has a node that no tetrahedron uses (node tag " +
                              std::to_string(tag) + ")");
             tri.push_back(n->second);
             nodes.insert(n->second);
@@ -226,21 +225,20 @@ Mesh read_sector_mesh(const std::filesystem::path& file, const ReadOptions& opti
     const auto& lo = mesh.node_sets.at(low);
     const auto& hi = mesh.node_sets.at(high);
     if (lo.size() != hi.size())
-      fail(file, std::string("unmatched nodes: '") + low + "' has " + std::to_string(lo.size()) +
-                     " nodes and '" + high + "' has " + std::to_string(hi.size()) +
-                     " (they must match one to one under the rotation by 360/" +
-                     std::to_string(options.sectors) + " deg)");
+      fail(file, std::string("unmatched nodes: '") + low + "' has " + std::to_string(lo.size()) + " nodes and '" +
+                     high + "' has " + std::to_string(hi.size()) +
+                     " (they must match one to one under the rotation by 360/" + std::to_string(options.sectors) +
+                     " deg)");
     const NodeMatch m = match_rotated_nodes(mesh.nodes, lo, hi, alpha, tol);
     if (!m.complete) {
       std::ostringstream s;
-      s << "unmatched nodes between '" << low << "' and '" << high << "' under the rotation by 360/"
-        << options.sectors << " deg: ";
+      s << "unmatched nodes between '" << low << "' and '" << high << "' under the rotation by 360/" << options.sectors
+        << " deg: ";
       if (m.worst_high >= 0)
-        s << "worst pair low node at " << point_text(mesh.nodes, m.worst_low)
-          << " -> nearest high node at " << point_text(mesh.nodes, m.worst_high) << ", distance "
-          << m.worst_distance << " m > tolerance " << tol << " m";
-      else
-        s << "the rotated low nodes do not map one to one onto the high nodes";
+        s << "worst pair low node at " << point_text(mesh.nodes, m.worst_low) << " -> nearest high node at "
+          << point_text(mesh.nodes, m.worst_high) << ", distance " << m.worst_distance << " m > tolerance " << tol
+          << " m";
+      else s << "the rotated low nodes do not map one to one onto the high nodes";
       fail(file, s.str());
     }
     out = m.pairs;
@@ -250,8 +248,7 @@ Mesh read_sector_mesh(const std::filesystem::path& file, const ReadOptions& opti
   if (mesh.node_sets.at(kHub).empty()) fail(file, "physical group 'hub' is empty");
 
   const QualityStats q = element_quality(mesh);
-  if (q.inverted > 0)
-    fail(file, std::to_string(q.inverted) + " inverted element(s) (non-positive Jacobian)");
+  if (q.inverted > 0) fail(file, std::to_string(q.inverted) + " inverted element(s) (non-positive Jacobian)");
   if (q.degenerate > 0) fail(file, std::to_string(q.degenerate) + " degenerate element(s)");
   return mesh;
 }

@@ -8,8 +8,8 @@
 namespace shroudsim::mesh {
 
 struct ReadOptions {
-  int sectors = 8;                    ///< Nb: the rotation is 2*pi/sectors about z
-  double match_tolerance = 1e-6;      ///< relative to the model size (bounding-box diagonal)
+  int sectors = 8;                ///< Nb: the rotation is 2*pi/sectors about z
+  double match_tolerance = 1e-6;  ///< relative to the model size (bounding-box diagonal)
 };
 
 /// Reads and checks: the 2D physical groups hub, cyclic_low, cyclic_high, shroud_low,

@@ -41,7 +41,8 @@ std::vector<std::pair<std::string, std::string>> SectorGeometry::validate() cons
   // A 180-degree sector (Nb = 2) has both radial sides on one plane through the axis, which
   // the contact-plane trimming below (half-spaces through the axis) cannot tell apart: Nb = 2
   // needs a mesh of one's own ([structure] mesh), which the cyclic reduction handles.
-  if (sectors < 3) v.emplace_back("structure.sectors", "sectors >= 3 for a generated sector (Nb = 2: give [structure] mesh)");
+  if (sectors < 3)
+    v.emplace_back("structure.sectors", "sectors >= 3 for a generated sector (Nb = 2: give [structure] mesh)");
   if (v.size()) return v;
   const double alpha = alpha_of(*this);
   if (disk_outer_radius <= hub_radius) add("disk_outer_radius", "disk_outer_radius > hub_radius");
@@ -58,11 +59,12 @@ std::vector<std::pair<std::string, std::string>> SectorGeometry::validate() cons
   if (0.5 * shroud_width * std::tan(a) >= 0.8 * rs * std::sin(0.5 * alpha))
     add("shroud_contact_angle_deg",
         "shroud_width/2 * tan(shroud_contact_angle_deg) < 0.8 * half the pitch at the shroud (contact faces must not cross)");
-  const double smallest = std::min({blade_length, blade_chord, disk_thickness, disk_outer_radius - hub_radius,
-                                    shroud_width, hub_radius * alpha});
+  const double smallest = std::min(
+      {blade_length, blade_chord, disk_thickness, disk_outer_radius - hub_radius, shroud_width, hub_radius * alpha});
   if (mesh_size > smallest)
-    add("mesh_size", "mesh_size <= the smallest of blade_length, blade_chord, disk_thickness, "
-                     "disk_outer_radius - hub_radius, shroud_width and the hub arc");
+    add("mesh_size",
+        "mesh_size <= the smallest of blade_length, blade_chord, disk_thickness, "
+        "disk_outer_radius - hub_radius, shroud_width and the hub arc");
   if (mesh_size < 1e-4 * (rs + shroud_thickness))
     add("mesh_size", "mesh_size >= 1e-4 * outer radius (finer meshes exceed any practical size)");
   return v;
@@ -78,9 +80,7 @@ double SectorGeometry::analytic_volume() const {
   const double shroud = 0.5 * alpha * (ro * ro - rs * rs) * shroud_width;
   // Blade between the cylinders r = rd and r = rs: integrate over the (untwisted) section
   // the radial length sqrt(rs^2 - x^2) - sqrt(rd^2 - x^2) (closed form of the x integral).
-  auto primitive = [](double r, double x) {
-    return 0.5 * (x * std::sqrt(r * r - x * x) + r * r * std::asin(x / r));
-  };
+  auto primitive = [](double r, double x) { return 0.5 * (x * std::sqrt(r * r - x * x) + r * r * std::asin(x / r)); };
   const double t = 0.5 * blade_thickness;
   const double blade = blade_chord * 2.0 * (primitive(rs, t) - primitive(rd, t));
   return disk + shroud + blade;
@@ -90,9 +90,8 @@ std::string SectorGeometry::fingerprint() const {
   std::ostringstream s;
   s.precision(17);
   s << "sector-v1 " << sectors << ' ' << hub_radius << ' ' << disk_outer_radius << ' ' << disk_thickness << ' '
-    << blade_length << ' ' << blade_chord << ' ' << blade_thickness << ' ' << blade_twist_deg << ' '
-    << shroud_thickness << ' ' << shroud_width << ' ' << shroud_contact_angle_deg << ' ' << element_order << ' '
-    << mesh_size;
+    << blade_length << ' ' << blade_chord << ' ' << blade_thickness << ' ' << blade_twist_deg << ' ' << shroud_thickness
+    << ' ' << shroud_width << ' ' << shroud_contact_angle_deg << ' ' << element_order << ' ' << mesh_size;
   return s.str();
 }
 
@@ -191,9 +190,8 @@ void sort_periodic_section(const std::filesystem::path& file) {
     i += 2;  // "dim tag tagMaster", "numAffine affine..."
     const long count = std::stol(lines.at(i++));
     auto first = lines.begin() + static_cast<long>(i);
-    std::sort(first, first + count, [](const std::string& a, const std::string& b) {
-      return std::stoull(a) < std::stoull(b);
-    });
+    std::sort(first, first + count,
+              [](const std::string& a, const std::string& b) { return std::stoull(a) < std::stoull(b); });
     i += static_cast<std::size_t>(count);
   }
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
@@ -237,8 +235,9 @@ GenerateReport generate_sector_mesh(const SectorGeometry& g, const std::filesyst
     // Shroud: a slab wider than the pitch, trimmed by the two inclined contact planes.
     const double margin = std::asin(std::min(1.0, (0.5 * g.shroud_width * std::tan(a) + 0.01 * ro) / rs)) + 0.01;
     int shroud = annular_sector(rs, ro, -0.5 * g.shroud_width, g.shroud_width, theta_low - margin, alpha + 2 * margin);
-    occ::cut({{3, shroud}}, {{3, half_space(e_r(theta_high), n_high, big, +1)}, {3, half_space(e_r(theta_low), n_low, big, -1)}},
-             out, map);
+    occ::cut({{3, shroud}},
+             {{3, half_space(e_r(theta_high), n_high, big, +1)}, {3, half_space(e_r(theta_low), n_low, big, -1)}}, out,
+             map);
     if (out.size() != 1) throw NumericalError("gmsh: trimming the shroud by its contact planes failed");
     shroud = out[0].second;
     // Blade: lofted slightly past both radii, then trimmed to rd <= r <= rs so that it sits
@@ -268,8 +267,9 @@ GenerateReport generate_sector_mesh(const SectorGeometry& g, const std::filesyst
       double cx = 0, cy = 0, cz = 0;
       occ::getCenterOfMass(2, tag, cx, cy, cz);
       const double rc = std::hypot(cx, cy);
-      const bool on_hub = std::all_of(pts.begin(), pts.end(),
-                                      [&](const Eigen::Vector3d& p) { return std::abs(std::hypot(p.x(), p.y()) - g.hub_radius) < tol; });
+      const bool on_hub = std::all_of(pts.begin(), pts.end(), [&](const Eigen::Vector3d& p) {
+        return std::abs(std::hypot(p.x(), p.y()) - g.hub_radius) < tol;
+      });
       // Which side: the face lies along the ray at theta_low or theta_high (for Nb = 2 both
       // radial sides are on one plane through the axis, so the plane alone cannot tell).
       const Eigen::Vector3d c(cx, cy, 0.0);
@@ -345,7 +345,8 @@ GenerateReport generate_sector_mesh(const SectorGeometry& g, const std::filesyst
     std::filesystem::remove(tmp);
     // Named as the file it would have become (the temporary name means nothing to a user).
     std::string what = e.what();
-    for (std::size_t at; (at = what.find(tmp.string())) != std::string::npos;) what.replace(at, tmp.string().size(), file.string());
+    for (std::size_t at; (at = what.find(tmp.string())) != std::string::npos;)
+      what.replace(at, tmp.string().size(), file.string());
     throw NumericalError("the generated mesh " + file.string() + " failed its checks: " + what);
   }
   report.quality = element_quality(mesh);

@@ -61,7 +61,6 @@ struct GenerateReport {
 /// is renamed only when the mesh passed every check: no inverted or degenerate element,
 /// matched cyclic and shroud nodes). Throws InputError for an inconsistent geometry and
 /// NumericalError when gmsh fails or the mesh fails its checks.
-GenerateReport generate_sector_mesh(const SectorGeometry& geometry,
-                                    const std::filesystem::path& file, bool verbose);
+GenerateReport generate_sector_mesh(const SectorGeometry& geometry, const std::filesystem::path& file, bool verbose);
 
 }  // namespace shroudsim::mesh

@@ -28,10 +28,9 @@ BlockKrylovSchurOptions block_krylov_schur_sizes(Eigen::Index n, int modes, int 
 }
 
 template <typename S>
-BlockKrylovSchurResult<S> block_krylov_schur(
-    const std::function<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>(
-        const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>&)>& apply,
-    Eigen::Index n, const BlockKrylovSchurOptions& options) {
+BlockKrylovSchurResult<S> block_krylov_schur(const std::function<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>(
+                                                 const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>&)>& apply,
+                                             Eigen::Index n, const BlockKrylovSchurOptions& options) {
   using Block = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
   const Eigen::Index nev = options.nev, b = options.block, mmax = options.basis, keep = options.keep;
   BlockKrylovSchurResult<S> result;

@@ -44,8 +44,8 @@ template <typename S>
 struct BlockKrylovSchurResult {
   using Block = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
   bool converged = false;
-  Eigen::VectorXd theta;   ///< converged: the nev largest Ritz values, ascending (else empty)
-  Block vectors;           ///< converged: their Ritz vectors V y (n x nev, orthonormal)
+  Eigen::VectorXd theta;     ///< converged: the nev largest Ritz values, ascending (else empty)
+  Block vectors;             ///< converged: their Ritz vectors V y (n x nev, orthonormal)
   int converged_values = 0;  ///< of the nev largest Ritz values at the end, those converged
   int steps = 0;             ///< block steps (applications of C to a block)
   int restarts = 0;          ///< thick restarts
@@ -53,9 +53,8 @@ struct BlockKrylovSchurResult {
 
 /// The nev largest eigenpairs of C, `apply` returning C X for a block X (n x b).
 template <typename S>
-BlockKrylovSchurResult<S> block_krylov_schur(
-    const std::function<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>(
-        const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>&)>& apply,
-    Eigen::Index n, const BlockKrylovSchurOptions& options);
+BlockKrylovSchurResult<S> block_krylov_schur(const std::function<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>(
+                                                 const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>&)>& apply,
+                                             Eigen::Index n, const BlockKrylovSchurOptions& options);
 
 }  // namespace shroudsim::modal

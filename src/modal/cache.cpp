@@ -1,8 +1,8 @@
 #include "modal/cache.hpp"
 
 #include <cstdint>
-#include <fstream>
 #include <cstring>
+#include <fstream>
 #include <random>
 #include <sstream>
 #include <string>
@@ -101,7 +101,8 @@ std::optional<std::istringstream> read_entry(const std::filesystem::path& path, 
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + size - sizeof stored, sizeof stored);
   bytes.resize(size - sizeof stored);
-  if (checksum(bytes.data(), bytes.size()) != stored) return fail("checksum mismatch (the file was changed or truncated)");
+  if (checksum(bytes.data(), bytes.size()) != stored)
+    return fail("checksum mismatch (the file was changed or truncated)");
   std::istringstream in(std::move(bytes), std::ios::binary);
   std::uint64_t m = 0;
   std::int64_t n = 0;

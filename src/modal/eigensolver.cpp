@@ -1,7 +1,7 @@
 #include "modal/eigensolver.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Spectra/SymEigsSolver.h>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -30,13 +30,9 @@ bool ModalOptions::validate(std::vector<std::string>* errors) const {
 
 Eigen::VectorXd ModalBasis::frequency_hz() const { return omega / (2.0 * M_PI); }
 
-ModalBasis ModalBasis::conjugate(int new_harmonic_index) const {
-  return {new_harmonic_index, omega, phi.conjugate()};
-}
+ModalBasis ModalBasis::conjugate(int new_harmonic_index) const { return {new_harmonic_index, omega, phi.conjugate()}; }
 
-std::string to_string(EigenMethod method) {
-  return method == EigenMethod::Block ? "block" : "spectra";
-}
+std::string to_string(EigenMethod method) { return method == EigenMethod::Block ? "block" : "spectra"; }
 
 std::string to_string(ModalStatus status) {
   switch (status) {
@@ -114,22 +110,20 @@ ModalResult finish(const linalg::SparsePair<S>& km, int h, Eigen::VectorXd lambd
   }
   if (k < options.modes && result.report.status == ModalStatus::Converged) {
     if (phi.rows() <= k) {
-      result.report.message = "only " + std::to_string(k) + " modes exist (" + std::to_string(phi.rows()) +
-                              " DOFs); " + std::to_string(options.modes) + " were asked for";
+      result.report.message = "only " + std::to_string(k) + " modes exist (" + std::to_string(phi.rows()) + " DOFs); " +
+                              std::to_string(options.modes) + " were asked for";
     } else {
       result.report.status = ModalStatus::TooFewModes;
-      result.report.message = "found " + std::to_string(k) + " distinct modes, " +
-                              std::to_string(options.modes) + " were asked for";
+      result.report.message =
+          "found " + std::to_string(k) + " distinct modes, " + std::to_string(options.modes) + " were asked for";
     }
   }
   if (!result.report.ok()) return result;
   if (!check_residuals(km, lam, vec, options, result.report)) return result;
   result.basis.harmonic_index = h;
   result.basis.omega = lam.cwiseMax(0.0).cwiseSqrt();
-  if constexpr (kIsComplex<S>)
-    result.basis.phi = vec;
-  else
-    result.basis.phi = vec.template cast<Complex>();
+  if constexpr (kIsComplex<S>) result.basis.phi = vec;
+  else result.basis.phi = vec.template cast<Complex>();
   return result;
 }
 
@@ -225,8 +219,7 @@ void physical_modes(const linalg::SparsePair<Complex>& km, const Eigen::VectorXd
 }
 
 template <typename S>
-ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOptions& options,
-                          FactorReuse* reuse) {
+ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOptions& options, FactorReuse* reuse) {
   const Eigen::Index n = km.K.rows();
   const Eigen::Index real_n = kIsComplex<S> ? 2 * n : n;
   ModalReport report;
@@ -257,8 +250,8 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
     report.solve_seconds = watch.seconds();
     report.status = ModalStatus::NotConverged;
     report.message = "Spectra SymEigsSolver (shift-invert): " + std::to_string(nconv) + " of " + std::to_string(nev) +
-                     " eigenvalues converged after " + std::to_string(report.iterations) +
-                     " restarts (CompInfo " + std::to_string(report.spectra_info) + ")";
+                     " eigenvalues converged after " + std::to_string(report.iterations) + " restarts (CompInfo " +
+                     std::to_string(report.spectra_info) + ")";
     ModalResult r;
     r.report = report;
     return r;
@@ -282,8 +275,7 @@ ModalResult solve_spectra(const linalg::SparsePair<S>& km, int h, const ModalOpt
     for (Eigen::Index j = 0; j < nu.size(); ++j) {
       if constexpr (kIsComplex<S>)
         yc = Y.col(j).head(n).template cast<S>() + S(0, 1) * Y.col(j).tail(n).template cast<S>();
-      else
-        yc = Y.col(j);
+      else yc = Y.col(j);
       factor->solve_backward(yc.data(), xc.data());
       Xs.col(j) = xc / std::sqrt(nu(j));
     }
@@ -377,13 +369,11 @@ ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int h, const Moda
   return solve_any<Complex>(km, h, options);
 }
 
-ModalResult solve_modes(const linalg::SparsePair<double>& km, int h, const ModalOptions& options,
-                        FactorReuse& reuse) {
+ModalResult solve_modes(const linalg::SparsePair<double>& km, int h, const ModalOptions& options, FactorReuse& reuse) {
   return solve_any<double>(km, h, options, &reuse);
 }
 
-ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int h, const ModalOptions& options,
-                        FactorReuse& reuse) {
+ModalResult solve_modes(const linalg::SparsePair<Complex>& km, int h, const ModalOptions& options, FactorReuse& reuse) {
   return solve_any<Complex>(km, h, options, &reuse);
 }
 

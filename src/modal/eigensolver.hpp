@@ -49,15 +49,15 @@ enum class EigenMethod {
 std::string to_string(EigenMethod method);
 
 struct ModalOptions {
-  int modes = 50;                  ///< lowest modes wanted per problem (>= 1)
+  int modes = 50;  ///< lowest modes wanted per problem (>= 1)
   EigenMethod method = EigenMethod::Block;
-  int block_size = 0;              ///< Block: vectors per block; 0: 4
-  double shift = 0.0;              ///< sigma [(rad/s)^2]; 0 factors K itself (kept for static solves).
-                                   ///< Use sigma < 0 for an unclamped (singular) K.
-  int ncv = 0;                     ///< basis size; 0: Spectra max(2 nev + 1, nev + 20),
-                                   ///< Block max(3 modes, modes + 3 block_size)
-  int max_restarts = 1000;         ///< Spectra maxit; Block: thick restarts allowed
-  double tolerance = 1e-10;        ///< Spectra's relative tolerance on the Ritz values
+  int block_size = 0;                ///< Block: vectors per block; 0: 4
+  double shift = 0.0;                ///< sigma [(rad/s)^2]; 0 factors K itself (kept for static solves).
+                                     ///< Use sigma < 0 for an unclamped (singular) K.
+  int ncv = 0;                       ///< basis size; 0: Spectra max(2 nev + 1, nev + 20),
+                                     ///< Block max(3 modes, modes + 3 block_size)
+  int max_restarts = 1000;           ///< Spectra maxit; Block: thick restarts allowed
+  double tolerance = 1e-10;          ///< Spectra's relative tolerance on the Ritz values
   double residual_tolerance = 1e-6;  ///< accepted ||K phi - w^2 M phi|| / ||K phi||
   linalg::FactorMethod factor_method = linalg::FactorMethod::Supernodal;
   /// Returns false and appends messages if a value is out of range.
@@ -101,7 +101,7 @@ struct ModalReport {
 };
 
 struct ModalResult {
-  ModalBasis basis;           ///< the converged modes (empty unless report.ok())
+  ModalBasis basis;  ///< the converged modes (empty unless report.ok())
   ModalReport report;
   StiffnessFactor stiffness;  ///< the factor of K when shift == 0 and it succeeded
 };

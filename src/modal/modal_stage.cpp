@@ -1,5 +1,5 @@
-#include "core/format.hpp"
 #include "modal/modal_stage.hpp"
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <mutex>
@@ -139,7 +139,8 @@ std::map<int, CachedModes> cached_modes(const std::function<const cyclic::Cyclic
     o.seconds = watch.seconds();
     if (!keep_factors) o.result.stiffness = StiffnessFactor();  // free the factor now
     const auto& r = o.result.report;
-    std::string line = "modes h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
+    std::string line =
+        "modes h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";
     if (r.ok()) {
       const Eigen::VectorXd f = o.result.basis.frequency_hz();
       line += std::to_string(f.size()) + " modes, " + fixed(f(0), 2) + " .. " + fixed(f(f.size() - 1), 2) + " Hz (" +

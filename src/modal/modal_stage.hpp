@@ -27,8 +27,8 @@
 namespace shroudsim::modal {
 
 struct StageCache {
-  std::filesystem::path dir;                         ///< created when an entry is written
-  std::function<void(const std::string&)> warn;      ///< corrupt entries, failed writes (may be empty)
+  std::filesystem::path dir;                     ///< created when an entry is written
+  std::function<void(const std::string&)> warn;  ///< corrupt entries, failed writes (may be empty)
 };
 
 /// Fingerprint of K and M: mesh (nodes, elements, groups) and material.
@@ -49,7 +49,7 @@ CachedMatrices cached_matrices(const mesh::Mesh& mesh, const fe::Material& mater
 
 /// The modes of one canonical harmonic index.
 struct CachedModes {
-  ModalResult result;   ///< result.report.method = "cache" when reused; result.stiffness kept only if asked
+  ModalResult result;  ///< result.report.method = "cache" when reused; result.stiffness kept only if asked
   bool reused = false;
   double seconds = 0.0;
 };

@@ -108,7 +108,8 @@ void RotatingHarmonic::set_variable_springs(const cyclic::CyclicSector& sector,
                                             const std::vector<cyclic::InterfaceSpring>& springs) {
   y_ = sector.interface_rows(h_, springs) * sector.expansion(h_);
   spring_k_.resize(y_.rows());
-  for (std::size_t i = 0; i < springs.size(); ++i) spring_k_.segment<3>(static_cast<Eigen::Index>(3 * i)) = springs[i].stiffness;
+  for (std::size_t i = 0; i < springs.size(); ++i)
+    spring_k_.segment<3>(static_cast<Eigen::Index>(3 * i)) = springs[i].stiffness;
 }
 
 ModalResult RotatingHarmonic::solve(double omega, const ModalOptions& options, const std::vector<bool>& closed) {

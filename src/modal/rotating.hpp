@@ -35,12 +35,12 @@ namespace shroudsim::modal {
 
 /// The rotating-frame operators at unit Omega^2 on all 3 * n_nodes DOFs.
 struct RotatingOperators {
-  Eigen::VectorXd load;              ///< f1 [N per (rad/s)^2]
-  Eigen::VectorXd displacement;      ///< u1 [m per (rad/s)^2], clamped DOFs zero
-  linalg::SparseMatrixD geometric;   ///< K_sigma1 [N/m per (rad/s)^2], pattern of K
-  linalg::SparseMatrixD spin;        ///< M_spin [kg], pattern of M
-  fe::PeakStress peak;               ///< largest von Mises stress of u1 [Pa per (rad/s)^2]
-  double seconds = 0.0;              ///< static solve and assembly of K_sigma1
+  Eigen::VectorXd load;             ///< f1 [N per (rad/s)^2]
+  Eigen::VectorXd displacement;     ///< u1 [m per (rad/s)^2], clamped DOFs zero
+  linalg::SparseMatrixD geometric;  ///< K_sigma1 [N/m per (rad/s)^2], pattern of K
+  linalg::SparseMatrixD spin;       ///< M_spin [kg], pattern of M
+  fe::PeakStress peak;              ///< largest von Mises stress of u1 [Pa per (rad/s)^2]
+  double seconds = 0.0;             ///< static solve and assembly of K_sigma1
   /// D = K_sigma1 - M_spin, so that K(Omega) = K + Omega^2 D.
   linalg::SparseMatrixD rotating_stiffness() const;
 };
@@ -75,12 +75,12 @@ class RotatingHarmonic {
  private:
   int h_ = 0;
   bool real_ = true;
-  linalg::SparsePair<double> real_pair_;      // {K_h(omega), M_h}, overwritten per speed
+  linalg::SparsePair<double> real_pair_;  // {K_h(omega), M_h}, overwritten per speed
   linalg::SparseMatrixD real_k0_, real_d_;
   linalg::SparsePair<Complex> complex_pair_;
   linalg::SparseMatrixC complex_k0_, complex_d_;
-  linalg::SparseMatrixC y_;            // Y_h (3 rows per variable spring), empty without
-  Eigen::VectorXd spring_k_;           // stiffness of each row of Y_h
+  linalg::SparseMatrixC y_;   // Y_h (3 rows per variable spring), empty without
+  Eigen::VectorXd spring_k_;  // stiffness of each row of Y_h
   FactorReuse reuse_;
 };
 

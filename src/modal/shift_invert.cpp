@@ -11,17 +11,13 @@ constexpr bool kIsComplex = !std::is_same_v<S, double>;
 
 template <typename S>
 std::shared_ptr<linalg::CholmodFactor<S>>& reuse_slot(FactorReuse& reuse) {
-  if constexpr (kIsComplex<S>)
-    return reuse.complex;
-  else
-    return reuse.real;
+  if constexpr (kIsComplex<S>) return reuse.complex;
+  else return reuse.real;
 }
 template <typename S>
 Eigen::Index& reuse_nonzeros(FactorReuse& reuse) {
-  if constexpr (kIsComplex<S>)
-    return reuse.complex_nonzeros;
-  else
-    return reuse.real_nonzeros;
+  if constexpr (kIsComplex<S>) return reuse.complex_nonzeros;
+  else return reuse.real_nonzeros;
 }
 
 }  // namespace
@@ -30,8 +26,8 @@ template <typename S>
 std::shared_ptr<linalg::CholmodFactor<S>> factor_shifted(const linalg::SparsePair<S>& km, double sigma,
                                                          linalg::FactorMethod method, FactorReuse* reuse) {
   std::shared_ptr<linalg::CholmodFactor<S>> factor;
-  linalg::SparseMatrix<S> A =
-      sigma == 0.0 ? linalg::SparseMatrix<S>(km.K) : linalg::SparseMatrix<S>(km.K - S(sigma) * km.M);
+  linalg::SparseMatrix<S> A = sigma == 0.0 ? linalg::SparseMatrix<S>(km.K)
+                                           : linalg::SparseMatrix<S>(km.K - S(sigma) * km.M);
   A.makeCompressed();
   if (reuse && reuse_slot<S>(*reuse) && reuse_slot<S>(*reuse)->rows() == A.rows() &&
       reuse_nonzeros<S>(*reuse) == A.nonZeros()) {

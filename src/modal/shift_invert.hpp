@@ -34,8 +34,8 @@ struct FactorReuse {
   std::shared_ptr<linalg::CholmodFactor<double>> real;
   std::shared_ptr<linalg::CholmodFactor<Complex>> complex;
   Eigen::Index real_nonzeros = -1, complex_nonzeros = -1;  ///< stored entries of the analyzed patterns
-  int analyses = 0;           ///< symbolic analyses done through this object
-  int factorizations = 0;     ///< numeric factorizations done through this object
+  int analyses = 0;                                        ///< symbolic analyses done through this object
+  int factorizations = 0;                                  ///< numeric factorizations done through this object
 };
 
 /// Factorizes K - sigma M (K itself when sigma == 0), reusing reuse's symbolic analysis when

@@ -4,14 +4,11 @@
 
 namespace shroudsim::modal {
 
-StiffnessFactor::StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>> real)
-    : real_(std::move(real)) {}
+StiffnessFactor::StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<double>> real) : real_(std::move(real)) {}
 StiffnessFactor::StiffnessFactor(std::shared_ptr<const linalg::CholmodFactor<Complex>> complex, bool conjugated)
     : complex_(std::move(complex)), conjugated_(conjugated) {}
 
-Eigen::Index StiffnessFactor::rows() const {
-  return real_ ? real_->rows() : complex_ ? complex_->rows() : 0;
-}
+Eigen::Index StiffnessFactor::rows() const { return real_ ? real_->rows() : complex_ ? complex_->rows() : 0; }
 
 Eigen::MatrixXcd StiffnessFactor::solve(const Eigen::MatrixXcd& b) const {
   SHROUDSIM_CHECK(valid(), "StiffnessFactor::solve without a factor");

@@ -41,10 +41,8 @@ class StiffnessFactor {
 /// The StiffnessFactor holding a (successful) factor of K itself, not conjugated.
 template <typename Scalar>
 StiffnessFactor make_stiffness_factor(std::shared_ptr<const linalg::CholmodFactor<Scalar>> f) {
-  if constexpr (std::is_same_v<Scalar, double>)
-    return StiffnessFactor(std::move(f));
-  else
-    return StiffnessFactor(std::move(f), false);
+  if constexpr (std::is_same_v<Scalar, double>) return StiffnessFactor(std::move(f));
+  else return StiffnessFactor(std::move(f), false);
 }
 
 /// Factorizes K (throws NumericalError if it is not positive definite).

@@ -22,10 +22,10 @@ using forced::peaks_shift_hz;
 
 /// Richardson extrapolation of a mesh ladder (`study --convergence`).
 struct MeshConvergence {
-  bool monotone = false;     ///< the last three values change in one direction, shrinking
-  double order = 0.0;        ///< observed order p: |e_k| ~ h^p
-  double extrapolated = 0.0; ///< finest + e2 / (r^p - 1)
-  double case_error = 0.0;   ///< |first value - best estimate| / |best estimate|
+  bool monotone = false;      ///< the last three values change in one direction, shrinking
+  double order = 0.0;         ///< observed order p: |e_k| ~ h^p
+  double extrapolated = 0.0;  ///< finest + e2 / (r^p - 1)
+  double case_error = 0.0;    ///< |first value - best estimate| / |best estimate|
 };
 
 /// From values on sizes h, h / r, h / r^2, ... (coarse to fine, at least three): with e1, e2

@@ -22,8 +22,10 @@ std::vector<Knob> convergence_knobs(const io::Case& c) {
     knobs.push_back({"contact pairs", "contact.pairs", {std::to_string(c.contact.pairs), quoted("all")}, {}});
   if (sector) {
     const int modes = c.modal.modes;
-    knobs.push_back({"modes kept", "modal.modes",
-                     {std::to_string(std::max(5, modes / 2)), std::to_string(modes), std::to_string(2 * modes)}, {}});
+    knobs.push_back({"modes kept",
+                     "modal.modes",
+                     {std::to_string(std::max(5, modes / 2)), std::to_string(modes), std::to_string(2 * modes)},
+                     {}});
     knobs.push_back({"residual flexibility", "modal.residual_flexibility", {"false", "true"}, {}});
   }
   const int h = c.hbm.harmonics_auto ? 5 : c.hbm.harmonics;
@@ -33,7 +35,8 @@ std::vector<Knob> convergence_knobs(const io::Case& c) {
     for (int v : {1, 3, h, 2 * h})
       if (v >= 1 && 2 * v + 1 <= 4 * n && (hs.empty() || std::to_string(v) != hs.back()) && v <= 200)
         hs.push_back(std::to_string(v));
-    std::sort(hs.begin(), hs.end(), [](const std::string& a, const std::string& b) { return std::stoi(a) < std::stoi(b); });
+    std::sort(hs.begin(), hs.end(),
+              [](const std::string& a, const std::string& b) { return std::stoi(a) < std::stoi(b); });
     hs.erase(std::unique(hs.begin(), hs.end()), hs.end());
     knobs.push_back({"harmonics H", "hbm.harmonics", hs, {{"hbm.time_samples", std::to_string(4 * n)}}});
     std::vector<std::string> ns;
@@ -42,7 +45,9 @@ std::vector<Knob> convergence_knobs(const io::Case& c) {
     ns.erase(std::unique(ns.begin(), ns.end()), ns.end());
     knobs.push_back({"time samples N", "hbm.time_samples", ns, {}});
     if (c.contact.model == contact::Model::full3d || c.contact.model == contact::Model::quasi3d) {
-      knobs.push_back({"tangential update", "contact.tangential_update", {quoted("radial_return"), quoted("exact_linear")},
+      knobs.push_back({"tangential update",
+                       "contact.tangential_update",
+                       {quoted("radial_return"), quoted("exact_linear")},
                        {{"hbm.time_samples", std::to_string(4 * n)}}});
       knobs.push_back({"contact model", "contact.model", {quoted("quasi3d"), quoted("full3d")}, {}});
     }

@@ -38,7 +38,8 @@ TEST_P(BadInput, ExitsTwoWithOneMessageNamingLineAndKey) {
   s.write("case.toml", GetParam().case_text);
   const CliResult r = s.run("mesh case.toml " + GetParam().args);
   EXPECT_EQ(r.status, kBadInput) << r.err;
-  for (const auto& part : GetParam().expected) EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
+  for (const auto& part : GetParam().expected)
+    EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
   // One message: a single line on stderr, no partial results.
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(s.dir() / "results" / "coarse" / "run.json"));
@@ -48,17 +49,42 @@ INSTANTIATE_TEST_SUITE_P(
     Cli, BadInput,
     ::testing::Values(
         BadRun{"syntax", "name = \"coarse\"\n[geometry\n", "", {"case.toml:2:", "TOML syntax error"}},
-        BadRun{"unknown_key", "[geometry]\nmesh_sise = 0.02\n", "", {"case.toml:2:1", "unknown key 'geometry.mesh_sise'", "geometry.mesh_size"}},
-        BadRun{"wrong_type", "[structure]\nsectors = \"eight\"\n", "", {"case.toml:2:11", "structure.sectors: expected an integer"}},
-        BadRun{"negative_modulus", "[material]\nyoungs_modulus = -2e11\n", "", {"case.toml:2:18", "material.youngs_modulus", "violates: > 0"}},
-        BadRun{"poisson", "[material]\npoisson_ratio = 0.5\n", "", {"case.toml:2:17", "material.poisson_ratio = 0.5", "< 0.5"}},
+        BadRun{"unknown_key",
+               "[geometry]\nmesh_sise = 0.02\n",
+               "",
+               {"case.toml:2:1", "unknown key 'geometry.mesh_sise'", "geometry.mesh_size"}},
+        BadRun{"wrong_type",
+               "[structure]\nsectors = \"eight\"\n",
+               "",
+               {"case.toml:2:11", "structure.sectors: expected an integer"}},
+        BadRun{"negative_modulus",
+               "[material]\nyoungs_modulus = -2e11\n",
+               "",
+               {"case.toml:2:18", "material.youngs_modulus", "violates: > 0"}},
+        BadRun{"poisson",
+               "[material]\npoisson_ratio = 0.5\n",
+               "",
+               {"case.toml:2:17", "material.poisson_ratio = 0.5", "< 0.5"}},
         BadRun{"zero_sectors", "[structure]\nsectors = 0\n", "", {"case.toml:2:11", "structure.sectors = 0"}},
-        BadRun{"mesh_size_above_blade", "[geometry]\nmesh_size = 0.1\n", "", {"case.toml:2:13", "geometry.mesh_size = 0.1", "mesh_size <="}},
-        BadRun{"missing_mesh", "[structure]\nmesh = \"meshes/none.msh\"\n", "", {"case.toml:2:8", "structure.mesh", "an existing mesh file"}},
-        BadRun{"bad_set_value", "", "--set hbm.harmonics=0", {"--set hbm.harmonics=0", "hbm.harmonics = 0", "violates"}},
+        BadRun{"mesh_size_above_blade",
+               "[geometry]\nmesh_size = 0.1\n",
+               "",
+               {"case.toml:2:13", "geometry.mesh_size = 0.1", "mesh_size <="}},
+        BadRun{"missing_mesh",
+               "[structure]\nmesh = \"meshes/none.msh\"\n",
+               "",
+               {"case.toml:2:8", "structure.mesh", "an existing mesh file"}},
+        BadRun{
+            "bad_set_value", "", "--set hbm.harmonics=0", {"--set hbm.harmonics=0", "hbm.harmonics = 0", "violates"}},
         BadRun{"bad_set_key", "", "--set contact.mu=0.2", {"--set contact.mu=0.2", "unknown key 'contact.mu'"}},
-        BadRun{"samples", "[hbm]\nharmonics = 10\ntime_samples = 16\n", "", {"case.toml:3:16", "hbm.time_samples = 16", "(= 21)"}},
-        BadRun{"blade_too_wide", "[geometry]\nblade_chord = 0.3\nblade_thickness = 0.01\n", "", {"case.toml:2:15", "geometry.blade_chord", "pitch"}}),
+        BadRun{"samples",
+               "[hbm]\nharmonics = 10\ntime_samples = 16\n",
+               "",
+               {"case.toml:3:16", "hbm.time_samples = 16", "(= 21)"}},
+        BadRun{"blade_too_wide",
+               "[geometry]\nblade_chord = 0.3\nblade_thickness = 0.01\n",
+               "",
+               {"case.toml:2:15", "geometry.blade_chord", "pitch"}}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.what); });
 
 TEST(Cli, UsageErrorsExitTwo) {
@@ -79,7 +105,8 @@ TEST(Cli, PrintDefaultsIsAValidCaseFile) {
   EXPECT_NE(r.out.find("tangential_update = \"exact_linear\""), std::string::npos);
   s.write("defaults.toml", r.out);
   // The printed file is accepted as it is (a mesh-free check: a bad key would exit 2).
-  const CliResult check = s.run("mesh defaults.toml --quiet --set geometry.mesh_size=0.03 --set geometry.element_order=1");
+  const CliResult check =
+      s.run("mesh defaults.toml --quiet --set geometry.mesh_size=0.03 --set geometry.element_order=1");
   EXPECT_EQ(check.status, 0) << check.err;
 }
 
@@ -194,8 +221,10 @@ TEST(Cli, AutoHarmonicsAndSamplesStopWhereThePeaksSettle) {
   const Scratch s("auto");
   s.write("case.toml", kLumpedCase);
   constexpr double kAutoTol = 1e-3;
-  const CliResult r = s.run("frf case.toml --quiet --set hbm.harmonics=\"auto\" --set hbm.time_samples=\"auto\" "
-                            "--set hbm.auto_tolerance=" + std::to_string(kAutoTol));
+  const CliResult r = s.run(
+      "frf case.toml --quiet --set hbm.harmonics=\"auto\" --set hbm.time_samples=\"auto\" "
+      "--set hbm.auto_tolerance=" +
+      std::to_string(kAutoTol));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto run = nlohmann::json::parse(slurp(s.dir() / "results" / "jenkins" / "run.json"));
   const auto& a = run.at("auto");
@@ -206,14 +235,16 @@ TEST(Cli, AutoHarmonicsAndSamplesStopWhereThePeaksSettle) {
   // The H search stops at the first H whose curve is within the tolerance of the one before,
   // and the N search likewise: the accepted trials met it, the ones before them did not.
   std::vector<nlohmann::json> h_trials, n_trials;
-  for (const auto& t : a.at("trials")) (t.at("time_samples") == n && t.at("harmonics") == h ? n_trials : h_trials).push_back(t);
+  for (const auto& t : a.at("trials"))
+    (t.at("time_samples") == n && t.at("harmonics") == h ? n_trials : h_trials).push_back(t);
   ASSERT_FALSE(n_trials.empty());
   const auto& accepted = n_trials.back();
   ASSERT_FALSE(accepted.at("relative_change").is_null());
   EXPECT_LT(accepted.at("relative_change").get<double>(), kAutoTol);
   int h_search_below = 0;
   for (const auto& t : a.at("trials"))
-    if (t.at("harmonics") != h && !t.at("relative_change").is_null() && t.at("relative_change").get<double>() < kAutoTol)
+    if (t.at("harmonics") != h && !t.at("relative_change").is_null() &&
+        t.at("relative_change").get<double>() < kAutoTol)
       ++h_search_below;
   EXPECT_EQ(h_search_below, 0) << "the H search went past an H that already met the tolerance";
   EXPECT_GE(a.at("trials").size(), 3u);
@@ -231,8 +262,9 @@ TEST(Cli, ConvergenceStudyTabulatesEveryKnobAgainstItsFinestValue) {
   ASSERT_EQ(r.status, 0) << r.err;
   const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "trade.csv"));
   ASSERT_GT(lines.size(), 1u);
-  EXPECT_EQ(lines[0], "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,"
-                      "peaks_error,peak_frequency_error_hz,folder,cpu_seconds");
+  EXPECT_EQ(lines[0],
+            "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,"
+            "peaks_error,peak_frequency_error_hz,folder,cpu_seconds");
   // Rows per knob, in the order coarse to fine: (value, error).
   std::map<std::string, std::vector<std::pair<std::string, double>>> knobs;
   for (std::size_t i = 1; i < lines.size(); ++i) {
@@ -320,7 +352,8 @@ TEST(Cli, ContinuationThatCannotFinishExitsThreeWithWhatItHas) {
   EXPECT_NE(r.err.find("max_points"), std::string::npos) << r.err;
   const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "frf.csv"));
   EXPECT_EQ(lines.size(), 6u);  // header + the 5 points computed
-  EXPECT_NE(slurp(s.dir() / "results" / "jenkins" / "run.json").find("\"status\": \"numerics_failed\""), std::string::npos);
+  EXPECT_NE(slurp(s.dir() / "results" / "jenkins" / "run.json").find("\"status\": \"numerics_failed\""),
+            std::string::npos);
 }
 
 TEST(Cli, StudyRunsEveryPointInItsOwnFolder) {
@@ -330,7 +363,8 @@ TEST(Cli, StudyRunsEveryPointInItsOwnFolder) {
   ASSERT_EQ(r.status, 0) << r.err;
   const auto lines = lines_of(slurp(s.dir() / "results" / "jenkins" / "study.csv"));
   ASSERT_EQ(lines.size(), 3u);
-  EXPECT_EQ(lines[0].rfind("contact.friction_coefficient,contact.normal_preload,status,peak_amplitude_m", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[0].rfind("contact.friction_coefficient,contact.normal_preload,status,peak_amplitude_m", 0), 0u)
+      << lines[0];
   EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "friction_coefficient=0.3__normal_preload=0.5" / "frf.csv"));
   // A higher preload sticks more: the 2 N point's peak is lower than the 0.5 N one.
   auto peak = [&](const std::string& line) { return std::stod(line.substr(line.find(",ok,") + 4)); };
@@ -348,9 +382,10 @@ TEST(Cli, ContactCommandWritesTheCircularOrbitSolution) {
   // constant normal load N = N0 + kn z0 = 1.1 N: |T| = mu N throughout (docs/physics.md section 6),
   // so the first harmonic of Tx has amplitude 0.33 N and the others vanish.
   const Scratch s("contact");
-  s.write("c.toml", "name = \"c\"\n[contact]\nmodel = \"full3d\"\nfriction_coefficient = 0.3\nnormal_preload = 1.0\n"
-                    "[hbm]\nharmonics = 3\ntime_samples = 256\n[motion]\nx = [[1, 1e-6, 0.0]]\ny = [[1, 0.0, 1e-6]]\n"
-                    "z = [[0, 1e-7, 0.0]]\n");
+  s.write("c.toml",
+          "name = \"c\"\n[contact]\nmodel = \"full3d\"\nfriction_coefficient = 0.3\nnormal_preload = 1.0\n"
+          "[hbm]\nharmonics = 3\ntime_samples = 256\n[motion]\nx = [[1, 1e-6, 0.0]]\ny = [[1, 0.0, 1e-6]]\n"
+          "z = [[0, 1e-7, 0.0]]\n");
   const CliResult r = s.run("contact c.toml --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string j = slurp(s.dir() / "results" / "c" / "contact.json");
@@ -371,7 +406,7 @@ TEST(Cli, ContactCommandWritesTheCircularOrbitSolution) {
     }
   }
   ASSERT_EQ(v.size(), 12u);
-  EXPECT_NEAR(std::hypot(v[4], v[5]), 0.33, 1e-9);  // harmonic 1 (exact_linear, constant N)
+  EXPECT_NEAR(std::hypot(v[4], v[5]), 0.33, 1e-9);                      // harmonic 1 (exact_linear, constant N)
   EXPECT_LT(std::hypot(v[7], v[8]) + std::hypot(v[10], v[11]), 1e-12);  // harmonics 2 and 3
   const CliResult bad = s.run("contact c.toml --set 'motion.x=[[1, 1e-6]]'");
   EXPECT_EQ(bad.status, 2);

@@ -120,7 +120,8 @@ TEST(CliContinuation, ACurveThatFailsItsEnergyCheckIsNotReportedAsSuccess) {
   EXPECT_FALSE(frf["energy_check_passed"].get<bool>());
   const std::string csv = slurp(s.dir() / "out" / "frf.csv");
   EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 100);
-  const CliResult good = s.run("frf " + std::string(SHROUDSIM_SOURCE_DIR) + "/cases/lumped_jenkins.toml --quiet --out out2");
+  const CliResult good =
+      s.run("frf " + std::string(SHROUDSIM_SOURCE_DIR) + "/cases/lumped_jenkins.toml --quiet --out out2");
   EXPECT_EQ(good.status, 0) << good.err;
 }
 

@@ -55,7 +55,8 @@ TEST(CliResults, AKilledRunLeavesTheOldFolderWhole) {
   int old_seen = 0, new_seen = 0;
   for (const char* at : {"0.3", "1.0", "2.0", "30"}) {
     // Scratch::run prefixes the executable: a harmless --version, then the timed run.
-    const CliResult r = s.run(std::string("--version >/dev/null; timeout -s KILL ") + at + " '" SHROUDSIM_EXE
+    const CliResult r = s.run(std::string("--version >/dev/null; timeout -s KILL ") + at +
+                              " '" SHROUDSIM_EXE
                               "' run c.toml --set continuation.frequency_end_hz=109.0 --out r --quiet; true");
     (void)r;
     const auto now = snapshot(s.dir() / "r");
@@ -136,7 +137,6 @@ TEST(CliResults, BadOutAndBadInputTouchNothing) {
   }
 }
 
-
 // A cache entry with a changed byte (K and M, and the modes of a harmonic index; at the
 // start, the middle and the end of the file) is reported and recomputed: the results are
 // those of a clean run. Not byte for byte: a mode solved alone or beside another harmonic
@@ -179,7 +179,6 @@ TEST(CliResults, CorruptedCacheEntriesAreRecomputedNotUsed) {
     }
   EXPECT_EQ(runs, 3 * static_cast<int>(entries.size()));
 }
-
 
 const char* kLumped = R"(name = "lumped"
 [structure]
@@ -246,7 +245,8 @@ TEST(CliResults, HostileInputsExitTwoBeforeAnyWork) {
   // The program's own mesh, truncated on disk: regenerated with a warning, not blamed on
   // the user.
   const std::string whole = slurp(s.dir() / "meshes" / "coarse.msh");
-  std::ofstream(s.dir() / "meshes" / "coarse.msh", std::ios::binary | std::ios::trunc) << whole.substr(0, whole.size() / 3);
+  std::ofstream(s.dir() / "meshes" / "coarse.msh", std::ios::binary | std::ios::trunc)
+      << whole.substr(0, whole.size() / 3);
   const CliResult again = s.run("mesh c.toml --out m");
   EXPECT_EQ(again.status, 0) << again.err;
   EXPECT_NE(again.err.find("regenerating"), std::string::npos) << again.err;

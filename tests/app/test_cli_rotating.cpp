@@ -32,7 +32,8 @@ rotating_effects = true
 // (speed, h, mode) -> frequency from campbell.csv.
 std::map<std::tuple<double, int, int>, double> campbell(const fs::path& file) {
   const auto rows = csv_rows(slurp(file));
-  EXPECT_EQ(rows.front(), (std::vector<std::string>{"speed_rpm", "harmonic_index", "nodal_diameter", "mode", "frequency_hz"}));
+  EXPECT_EQ(rows.front(),
+            (std::vector<std::string>{"speed_rpm", "harmonic_index", "nodal_diameter", "mode", "frequency_hz"}));
   std::map<std::tuple<double, int, int>, double> f;
   for (std::size_t i = 1; i < rows.size(); ++i)
     f[{std::stod(rows[i][0]), std::stoi(rows[i][1]), std::stoi(rows[i][3])}] = std::stod(rows[i][4]);
@@ -52,7 +53,8 @@ TEST(CliRotating, CampbellFrequenciesDependOnSpeedAndCrossingsLieOnTheEngineOrde
   // Each crossing is on its line f = EO rpm / 60, between two speed points where
   // f_r - EO rpm / 60 changes sign.
   const auto cross = csv_rows(slurp(s.dir() / "results" / "coarse" / "crossings.csv"));
-  ASSERT_EQ(cross.front(), (std::vector<std::string>{"engine_order", "nodal_diameter", "mode", "speed_rpm", "frequency_hz"}));
+  ASSERT_EQ(cross.front(),
+            (std::vector<std::string>{"engine_order", "nodal_diameter", "mode", "speed_rpm", "frequency_hz"}));
   ASSERT_GT(cross.size(), 1u);
   for (std::size_t i = 1; i < cross.size(); ++i) {
     const int e = std::stoi(cross[i][0]), mode = std::stoi(cross[i][2]);

@@ -34,7 +34,8 @@ std::map<std::pair<int, int>, double> modes_csv(const fs::path& file) {
   std::map<std::pair<int, int>, double> f;
   const auto rows = csv_rows(slurp(file));
   EXPECT_EQ(rows.front(), (std::vector<std::string>{"harmonic_index", "nodal_diameter", "mode", "frequency_hz"}));
-  for (std::size_t i = 1; i < rows.size(); ++i) f[{std::stoi(rows[i][0]), std::stoi(rows[i][2])}] = std::stod(rows[i][3]);
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    f[{std::stoi(rows[i][0]), std::stoi(rows[i][2])}] = std::stod(rows[i][3]);
   return f;
 }
 
@@ -101,7 +102,6 @@ TEST(CliShroud, BadShroudValueExitsTwoNamingTheKey) {
   EXPECT_NE(r.err.find("modal.shroud"), std::string::npos) << r.err;
 }
 
-
 // The 36-blade wheel of cases/shrouded_wheel.toml, coarse: twist -20 degrees (the untwist
 // at speed closes the shroud).
 const char* kWheelCase = R"(name = "wheel"
@@ -133,8 +133,9 @@ std::vector<StaticRow> static_rows(const fs::path& file) {
   const std::string text = slurp(file);
   EXPECT_EQ(text.find("nan"), std::string::npos);
   const auto cells = csv_rows(text);
-  EXPECT_EQ(cells.front(), (std::vector<std::string>{"pair", "high_node", "low_node", "x_m", "y_m", "z_m", "area_m2", "state",
-                                                     "gap_m", "normal_load_n", "tangential_load_n", "pressure_pa"}));
+  EXPECT_EQ(cells.front(),
+            (std::vector<std::string>{"pair", "high_node", "low_node", "x_m", "y_m", "z_m", "area_m2", "state", "gap_m",
+                                      "normal_load_n", "tangential_load_n", "pressure_pa"}));
   std::vector<StaticRow> rows;
   for (std::size_t i = 1; i < cells.size(); ++i)
     rows.push_back({cells[i][7], std::stod(cells[i][8]), std::stod(cells[i][9]), std::stod(cells[i][10])});
@@ -154,7 +155,8 @@ TEST(CliShroud, StaticContactAtRestIsUnloadedWithoutInterferenceAndLinearInIt) {
   // twice every load (whatever sticks or slips), to the solver's tolerance.
   ASSERT_EQ(s.run("static wheel.toml --set contact.interference=1e-5 --out d1 --quiet").status, 0);
   ASSERT_EQ(s.run("static wheel.toml --set contact.interference=2e-5 --out d2 --quiet").status, 0);
-  const auto a = static_rows(s.dir() / "d1" / "static_contact.csv"), b = static_rows(s.dir() / "d2" / "static_contact.csv");
+  const auto a = static_rows(s.dir() / "d1" / "static_contact.csv"),
+             b = static_rows(s.dir() / "d2" / "static_contact.csv");
   ASSERT_EQ(a.size(), b.size());
   ASSERT_GT(a.size(), 0u);
   double total = 0.0;
@@ -210,7 +212,6 @@ TEST(CliShroud, TheShroudClosesAtSpeedAndCampbellFollowsTheContact) {
   EXPECT_GT(top.at({18, 1}), 1.3 * top.at({0, 1}));
 }
 
-
 TEST(CliShroud, ForcedResponsePreloadsFromTheStaticContact) {
   Scratch s("static_preload");
   s.write("wheel.toml", kWheelCase);
@@ -228,8 +229,9 @@ TEST(CliShroud, ForcedResponsePreloadsFromTheStaticContact) {
   EXPECT_NEAR(m["normal_preload_total_n"].get<double>(), load, 1e-9 * load);
   EXPECT_NEAR(m["static_normal_load_n"].get<double>(), load, 1e-9 * load);
 
-  s.write("lumped.toml", "[structure]\ntype = \"lumped\"\nmass = [[1.0]]\nstiffness = [[1.0]]\n"
-                         "[contact]\nnormal_preload = \"static\"\n[[contact.elements]]\nx_dof = 0\n");
+  s.write("lumped.toml",
+          "[structure]\ntype = \"lumped\"\nmass = [[1.0]]\nstiffness = [[1.0]]\n"
+          "[contact]\nnormal_preload = \"static\"\n[[contact.elements]]\nx_dof = 0\n");
   const CliResult bad = s.run("frf lumped.toml --quiet");
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("contact.normal_preload"), std::string::npos) << bad.err;

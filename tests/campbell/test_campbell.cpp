@@ -41,7 +41,7 @@ TEST(Campbell, FlatLinesCrossAtSixtyFOverE) {
   for (const campbell::Crossing& x : rows) {
     EXPECT_NEAR(x.speed_rpm * x.engine_order / 60.0, x.frequency_hz, 1e-9 * x.frequency_hz);
     const double f = (x.engine_order % 8 == 1 || x.engine_order % 8 == 7) ? (x.mode == 1 ? 40.0 : 95.0)
-                                                                            : (x.mode == 1 ? 70.0 : 150.0);
+                                                                          : (x.mode == 1 ? 70.0 : 150.0);
     EXPECT_NEAR(x.frequency_hz, f, 1e-9 * f) << "EO " << x.engine_order << " mode " << x.mode;
     EXPECT_EQ(x.nodal_diameter, x.engine_order % 8 == 2 ? 2 : (x.engine_order == 10 ? 2 : 1));
   }

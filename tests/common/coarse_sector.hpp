@@ -24,7 +24,8 @@ struct CoarseSector {
     mesh::SectorGeometry g;
     g.element_order = element_order;
     g.mesh_size = mesh_size;
-    const auto file = std::filesystem::temp_directory_path() / ("shroudsim_" + tag + "_" + std::to_string(::getpid()) + ".msh");
+    const auto file =
+        std::filesystem::temp_directory_path() / ("shroudsim_" + tag + "_" + std::to_string(::getpid()) + ".msh");
     mesh::generate_sector_mesh(g, file, false);
     mesh = mesh::read_sector_mesh(file, {g.sectors, 1e-9});
     std::filesystem::remove(file);

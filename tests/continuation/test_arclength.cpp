@@ -232,7 +232,8 @@ class Vee : public ParametricResidual {
  public:
   int size() const override { return 1; }
   bool has_lambda_derivative() const override { return true; }
-  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd* dl) override {
+  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J,
+                Eigen::VectorXd* dl) override {
     r = Eigen::VectorXd::Constant(1, x[0] - 3.0 * std::abs(l - 1.0));
     if (J) *J = Eigen::MatrixXd::Identity(1, 1);
     if (dl) *dl = Eigen::VectorXd::Constant(1, l > 1.0 ? -3.0 : 3.0);

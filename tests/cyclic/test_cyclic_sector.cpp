@@ -137,7 +137,6 @@ TEST(CyclicSector, MismatchedPairsAreRejected) {
   EXPECT_THROW(CyclicSector(m, fe::assemble(m, kSteel, 1)), InputError);
 }
 
-
 // ---- Interface springs (the stuck shroud) against the full wheel ----
 
 // Node of the sector at (r, theta / alpha, z) nearest to the given point (an exact grid node).
@@ -287,7 +286,8 @@ TEST(CyclicSector, StiffSpringsTendToTheTiedWheel) {
   for (int v = 0; v < wheel.n_nodes(); ++v)
     for (int c = 0; c < 3; ++c)
       if (column[3 * target[v] + c] >= 0) Z(3 * v + c, column[3 * target[v] + c]) = 1.0;
-  const Eigen::MatrixXd Kt = Z.transpose() * Eigen::MatrixXd(kmw.K) * Z, Mt = Z.transpose() * Eigen::MatrixXd(kmw.M) * Z;
+  const Eigen::MatrixXd Kt = Z.transpose() * Eigen::MatrixXd(kmw.K) * Z,
+                        Mt = Z.transpose() * Eigen::MatrixXd(kmw.M) * Z;
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Kt, Mt, Eigen::EigenvaluesOnly);
   const Eigen::VectorXd tied = es.eigenvalues();
   // Penalty error of the lowest 20 modes at k = 1e3 and 1e4 times the largest diagonal entry.

@@ -109,8 +109,8 @@ TEST_P(TotalMass, EqualsDensityTimesMeshedVolume) {
     const mesh::Mesh m = annular_sector_mesh(s);
     const double v = meshed_volume(m);
     const double alpha = 2.0 * std::numbers::pi / s.sectors;
-    const double polygon = 0.5 * (s.r_outer * s.r_outer - s.r_inner * s.r_inner) * s.n_theta *
-                           std::sin(alpha / s.n_theta) * s.thickness;
+    const double polygon =
+        0.5 * (s.r_outer * s.r_outer - s.r_inner * s.r_inner) * s.n_theta * std::sin(alpha / s.n_theta) * s.thickness;
     EXPECT_NEAR(v, polygon, kTol * polygon);
     const auto km = assemble(m, kSteel, 2);
     Eigen::VectorXd e = Eigen::VectorXd::Zero(m.n_dofs());

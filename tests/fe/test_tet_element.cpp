@@ -23,7 +23,8 @@ TEST(TetQuadrature, IntegratesMonomialsExactlyUpToItsDegree) {
         for (int c = 0; a + b + c <= degree; ++c) {
           double sum = 0.0;
           for (int k = 0; k < q.size(); ++k)
-            sum += q.weights[k] * std::pow(q.points[k](0), a) * std::pow(q.points[k](1), b) * std::pow(q.points[k](2), c);
+            sum +=
+                q.weights[k] * std::pow(q.points[k](0), a) * std::pow(q.points[k](1), b) * std::pow(q.points[k](2), c);
           const double exact = factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
           EXPECT_NEAR(sum, exact, kTol) << "degree " << degree << " monomial " << a << b << c;
         }

@@ -38,7 +38,7 @@ TEST(DiscretizationSearch, RaisesHThenNUntilThePeaksSettle) {
   // H: 1, 3, 5, 7, 10, 15 with N = 16 (2H + 1) rounded up to a power of two, at least 256;
   // 10 -> 15 changes the peak by 0.09 % (< 1 %): H = 15. Then N from 4 (2H + 1) = 124 -> 128:
   // 128 -> 256 changes it by 0.77 %: N = 256.
-  const std::vector<std::pair<int, int>> expected = {{1, 256}, {3, 256}, {5, 256},  {7, 256},
+  const std::vector<std::pair<int, int>> expected = {{1, 256},  {3, 256},  {5, 256},  {7, 256},
                                                      {10, 512}, {15, 512}, {15, 128}, {15, 256}};
   EXPECT_EQ(seen, expected);
   EXPECT_EQ(r.harmonics, 15);
@@ -48,7 +48,8 @@ TEST(DiscretizationSearch, RaisesHThenNUntilThePeaksSettle) {
   // No (H, N) is traced twice.
   for (std::size_t i = 0; i < r.trials.size(); ++i)
     for (std::size_t j = i + 1; j < r.trials.size(); ++j)
-      EXPECT_FALSE(r.trials[i].harmonics == r.trials[j].harmonics && r.trials[i].time_samples == r.trials[j].time_samples);
+      EXPECT_FALSE(r.trials[i].harmonics == r.trials[j].harmonics &&
+                   r.trials[i].time_samples == r.trials[j].time_samples);
   EXPECT_EQ(calls, static_cast<int>(r.trials.size()));
   const DiscretizationTrial& chosen = r.trials[r.chosen];
   EXPECT_EQ(chosen.harmonics, 15);

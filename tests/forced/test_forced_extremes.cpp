@@ -47,10 +47,9 @@ TEST_P(Extremes, ConvergeToTheLimitOrStopCleanly) {
   frf::LumpedContact lc;
   lc.dof = one_d ? std::array<int, 3>{0, -1, -1} : std::array<int, 3>{0, 1, 2};
   ForcedModel model;
-  model.linear = std::make_unique<frf::LumpedLinearPart>(Eigen::MatrixXd::Identity(dofs, dofs) * m,
-                                                         Eigen::MatrixXd::Identity(dofs, dofs) * k,
-                                                         Eigen::MatrixXd::Identity(dofs, dofs) * c,
-                                                         std::vector<frf::LumpedContact>{lc}, 0, force, 0);
+  model.linear = std::make_unique<frf::LumpedLinearPart>(
+      Eigen::MatrixXd::Identity(dofs, dofs) * m, Eigen::MatrixXd::Identity(dofs, dofs) * k,
+      Eigen::MatrixXd::Identity(dofs, dofs) * c, std::vector<frf::LumpedContact>{lc}, 0, force, 0);
   contact::PairParameters pair;
   pair.tangential_stiffness = e.kt;
   pair.normal_stiffness = e.kn;
@@ -102,11 +101,8 @@ TEST_P(Extremes, ConvergeToTheLimitOrStopCleanly) {
       case Expect::free:
         EXPECT_NEAR(r.amplitude, r.linear_amplitude, kLimitTol * r.linear_amplitude) << p.lambda;
         break;
-      case Expect::stuck:
-        EXPECT_NEAR(r.amplitude, stuck.amplitude, kLimitTol * stuck.amplitude) << p.lambda;
-        break;
-      case Expect::bounded:
-        break;
+      case Expect::stuck: EXPECT_NEAR(r.amplitude, stuck.amplitude, kLimitTol * stuck.amplitude) << p.lambda; break;
+      case Expect::bounded: break;
     }
     peak = std::max(peak, r.amplitude);
     free_peak = std::max(free_peak, r.linear_amplitude);
@@ -123,32 +119,31 @@ constexpr auto quasi3d = contact::Model::quasi3d;
 constexpr auto one_d = contact::Model::one_d;
 const double k0 = std::pow(2 * kPi * 10.0, 2);  // the structure's own stiffness, 3948 N/m
 
-INSTANTIATE_TEST_SUITE_P(
-    Matrix, Extremes,
-    ::testing::Values(
-        // contact stiffness 1e3 .. 1e11 N/m (0.25 .. 2.5e7 times the structure's)
-        Extreme{"kt_1e3", full3d, 1e3, 1e3, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
-        Extreme{"kt_1e11", full3d, 1e11, 1e11, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
-        Extreme{"kt_1e11_1d", one_d, 1e11, 1.0, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
-        Extreme{"kn_1e3_kt_1e11", full3d, 1e11, 1e3, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
-        // preload: a gap that never closes, zero, large (never slips)
-        Extreme{"gap", full3d, k0, k0, 0.3, -1e3, 0.01, 5, 256, Expect::free},
-        Extreme{"zero_preload", full3d, k0, k0, 0.3, 0.0, 0.01, 5, 256, Expect::bounded},
-        Extreme{"huge_preload", full3d, k0, k0, 0.3, 1e6, 0.01, 5, 256, Expect::stuck},
-        // friction 0 .. 1e3
-        Extreme{"mu_0", full3d, k0, k0, 0.0, 1.0, 0.01, 5, 256, Expect::free},
-        Extreme{"mu_0_quasi3d", quasi3d, k0, k0, 0.0, 1.0, 0.01, 5, 256, Expect::free},
-        Extreme{"mu_1e3", full3d, k0, k0, 1e3, 1.0, 0.01, 5, 256, Expect::stuck},
-        Extreme{"mu_1e3_1d", one_d, k0, 1.0, 1e3, 1.0, 0.01, 5, 256, Expect::stuck},
-        // damping ratio 1e-5 .. 0.1
-        Extreme{"zeta_1em5", full3d, k0, k0, 0.3, 1.0, 1e-5, 5, 256, Expect::bounded},
-        Extreme{"zeta_1em5_1d", one_d, k0, 1.0, 0.3, 1.0, 1e-5, 5, 256, Expect::bounded},
-        Extreme{"zeta_0p1", full3d, k0, k0, 0.3, 1.0, 0.1, 5, 256, Expect::bounded},
-        // harmonics and samples
-        Extreme{"H_25", full3d, k0, k0, 0.3, 1.0, 0.01, 25, 256, Expect::bounded},
-        Extreme{"H_25_N_51", one_d, k0, 1.0, 0.3, 1.0, 0.01, 25, 51, Expect::bounded},
-        Extreme{"N_4096", full3d, k0, k0, 0.3, 1.0, 0.01, 3, 4096, Expect::bounded}),
-    name_of);
+INSTANTIATE_TEST_SUITE_P(Matrix, Extremes,
+                         ::testing::Values(
+                             // contact stiffness 1e3 .. 1e11 N/m (0.25 .. 2.5e7 times the structure's)
+                             Extreme{"kt_1e3", full3d, 1e3, 1e3, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
+                             Extreme{"kt_1e11", full3d, 1e11, 1e11, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
+                             Extreme{"kt_1e11_1d", one_d, 1e11, 1.0, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
+                             Extreme{"kn_1e3_kt_1e11", full3d, 1e11, 1e3, 0.3, 1.0, 0.01, 5, 256, Expect::bounded},
+                             // preload: a gap that never closes, zero, large (never slips)
+                             Extreme{"gap", full3d, k0, k0, 0.3, -1e3, 0.01, 5, 256, Expect::free},
+                             Extreme{"zero_preload", full3d, k0, k0, 0.3, 0.0, 0.01, 5, 256, Expect::bounded},
+                             Extreme{"huge_preload", full3d, k0, k0, 0.3, 1e6, 0.01, 5, 256, Expect::stuck},
+                             // friction 0 .. 1e3
+                             Extreme{"mu_0", full3d, k0, k0, 0.0, 1.0, 0.01, 5, 256, Expect::free},
+                             Extreme{"mu_0_quasi3d", quasi3d, k0, k0, 0.0, 1.0, 0.01, 5, 256, Expect::free},
+                             Extreme{"mu_1e3", full3d, k0, k0, 1e3, 1.0, 0.01, 5, 256, Expect::stuck},
+                             Extreme{"mu_1e3_1d", one_d, k0, 1.0, 1e3, 1.0, 0.01, 5, 256, Expect::stuck},
+                             // damping ratio 1e-5 .. 0.1
+                             Extreme{"zeta_1em5", full3d, k0, k0, 0.3, 1.0, 1e-5, 5, 256, Expect::bounded},
+                             Extreme{"zeta_1em5_1d", one_d, k0, 1.0, 0.3, 1.0, 1e-5, 5, 256, Expect::bounded},
+                             Extreme{"zeta_0p1", full3d, k0, k0, 0.3, 1.0, 0.1, 5, 256, Expect::bounded},
+                             // harmonics and samples
+                             Extreme{"H_25", full3d, k0, k0, 0.3, 1.0, 0.01, 25, 256, Expect::bounded},
+                             Extreme{"H_25_N_51", one_d, k0, 1.0, 0.3, 1.0, 0.01, 25, 51, Expect::bounded},
+                             Extreme{"N_4096", full3d, k0, k0, 0.3, 1.0, 0.01, 3, 4096, Expect::bounded}),
+                         name_of);
 
 }  // namespace
 }  // namespace shroudsim::forced

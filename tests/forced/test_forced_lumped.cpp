@@ -4,8 +4,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "continuation/arclength.hpp"
 #include "contact/jenkins.hpp"
+#include "continuation/arclength.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/lumped.hpp"
 #include "hbm/contact_evaluator.hpp"
@@ -61,9 +61,9 @@ continuation::ArclengthOptions options(double scale) {
   return o;
 }
 
-continuation::Branch trace_one_dof(const OneDof& sys, contact::Model model, int h, int n,
-                                   hbm::JacobianMethod jac, frf::LumpedLinearPart& linear,
-                                   std::unique_ptr<hbm::ContactEvaluator>& ev, std::unique_ptr<ReducedEquations>& eq) {
+continuation::Branch trace_one_dof(const OneDof& sys, contact::Model model, int h, int n, hbm::JacobianMethod jac,
+                                   frf::LumpedLinearPart& linear, std::unique_ptr<hbm::ContactEvaluator>& ev,
+                                   std::unique_ptr<ReducedEquations>& eq) {
   hbm::ContactEvaluatorOptions o;
   o.n_harmonics = h;
   o.n_time_samples = n;
@@ -170,7 +170,8 @@ TEST(ForcedLumped, DiscreteJenkinsConvergesToTheDescribingFunction) {
     const auto b = trace_one_dof(sys, contact::Model::one_d, 1, n, hbm::JacobianMethod::analytic, linear, ev, eq);
     ASSERT_EQ(b.status, continuation::BranchStatus::kReachedEnd) << b.message;
     double worst = 0.0;
-    for (const auto& p : b.points) worst = std::max(worst, sys.describing_function_error(std::hypot(p.x[1], p.x[2]), 2 * kPi * p.lambda));
+    for (const auto& p : b.points)
+      worst = std::max(worst, sys.describing_function_error(std::hypot(p.x[1], p.x[2]), 2 * kPi * p.lambda));
     if (previous > 0) {
       EXPECT_LT(worst, previous / 8.0) << "four times the samples should cut the error ~16x";
     }
@@ -184,7 +185,8 @@ TEST(ForcedLumped, FiniteDifferenceJacobianGivesTheSameCurve) {
   std::unique_ptr<hbm::ContactEvaluator> ev1, ev2;
   std::unique_ptr<ReducedEquations> eq1, eq2;
   const auto a = trace_one_dof(sys, contact::Model::one_d, 3, 128, hbm::JacobianMethod::analytic, linear, ev1, eq1);
-  const auto f = trace_one_dof(sys, contact::Model::one_d, 3, 128, hbm::JacobianMethod::finite_difference, linear, ev2, eq2);
+  const auto f =
+      trace_one_dof(sys, contact::Model::one_d, 3, 128, hbm::JacobianMethod::finite_difference, linear, ev2, eq2);
   ASSERT_EQ(a.status, continuation::BranchStatus::kReachedEnd);
   ASSERT_EQ(f.status, continuation::BranchStatus::kReachedEnd);
   // Each finite-difference point lies on the analytic curve: its residual with the analytic
@@ -252,8 +254,8 @@ struct PointMass3d {
     e.frame_angle = angle;
     Eigen::MatrixXd kk = k * Eigen::MatrixXd::Identity(3, 3);
     kk(2, 2) *= 1.5;
-    return frf::LumpedLinearPart(Eigen::MatrixXd::Identity(3, 3), kk, 2 * 0.01 * std::sqrt(k) * Eigen::MatrixXd::Identity(3, 3),
-                                 {e}, 0, 0.5, 0);
+    return frf::LumpedLinearPart(Eigen::MatrixXd::Identity(3, 3), kk,
+                                 2 * 0.01 * std::sqrt(k) * Eigen::MatrixXd::Identity(3, 3), {e}, 0, 0.5, 0);
   }
   contact::PairParameters pair() const {
     contact::PairParameters p;

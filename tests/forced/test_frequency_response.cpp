@@ -105,7 +105,8 @@ void expect_time_rescaling_invariance(Lumped (*make)(double)) {
   for (double s : scales) {
     Lumped l = make(s);
     r.push_back(trace(l));
-    ASSERT_EQ(r.back().summary.status, continuation::BranchStatus::kReachedEnd) << "s = " << s << ": " << r.back().summary.message;
+    ASSERT_EQ(r.back().summary.status, continuation::BranchStatus::kReachedEnd)
+        << "s = " << s << ": " << r.back().summary.message;
     ASSERT_FALSE(r.back().peaks.empty());
   }
   for (std::size_t i = 0; i < r.size(); ++i) {

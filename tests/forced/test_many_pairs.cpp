@@ -15,10 +15,10 @@
 #include "cyclic/cyclic_sector.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/lumped.hpp"
-#include "three_contacts.hpp"
 #include "frf/sector.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "modal/harmonic.hpp"
+#include "three_contacts.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -163,14 +163,16 @@ TEST(ManyPairs, BorderedKrylovSolveEqualsTheDenseSolveAndRefactorsWhenThePrecond
   // A matrix the lagged factors do not resemble (columns rescaled up to 6 times): GMRES
   // does not converge within its iteration cap and the solve renews the factors, still exact.
   so.krylov_max_iterations = 3;
-  eq.set_linear_solver(so);  // drops the factors
+  eq.set_linear_solver(so);                   // drops the factors
   ASSERT_TRUE(eq.solve_bordered(a1, b, d1));  // factors a1 again
-  const Eigen::VectorXd far_xs = xs.cwiseProduct((1.0 + 5.0 * Eigen::ArrayXd::LinSpaced(n, 0.0, 1.0).square()).matrix());
+  const Eigen::VectorXd far_xs =
+      xs.cwiseProduct((1.0 + 5.0 * Eigen::ArrayXd::LinSpaced(n, 0.0, 1.0).square()).matrix());
   const continuation::BorderedMatrix far{rs, far_xs, l1.column, l1.row};
   const int factorizations = eq.statistics().dense_factorizations, failures = eq.statistics().krylov_failures;
   Eigen::VectorXd d2;
   ASSERT_TRUE(eq.solve_bordered(far, b, d2));
-  EXPECT_GE(eq.statistics().krylov_failures, failures + 1);  // + 1 more if 3 iterations on the new factors fall short too
+  EXPECT_GE(eq.statistics().krylov_failures,
+            failures + 1);  // + 1 more if 3 iterations on the new factors fall short too
   EXPECT_EQ(eq.statistics().dense_factorizations, factorizations + 1);
   const Eigen::MatrixXd ad2 = dense_bordered(l1.J, far);
   const Eigen::VectorXd ref2 = Eigen::PartialPivLU<Eigen::MatrixXd>(ad2).solve(b);
@@ -249,7 +251,8 @@ struct Sector : testing_support::CoarseSector {
     forcing.response_node = mesh.n_nodes() / 3;
     forcing.force = Eigen::Vector3d(1.0, 1.0, 1.0);
     forcing.residual_flexibility = residual;
-    return frf::SectorLinearPart(*sector, bases, [&](int h) { return factors.at(h); }, pairs, forcing, 2);
+    return frf::SectorLinearPart(
+        *sector, bases, [&](int h) { return factors.at(h); }, pairs, forcing, 2);
   }
 };
 

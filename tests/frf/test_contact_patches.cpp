@@ -43,7 +43,8 @@ TEST(ContactPatches, PartitionCoversTheFaceAndWeightsSumToOne) {
   double face_area = 0.0;
   const auto& tris = f.mesh.surface_triangles.at(mesh::kShroudHigh);
   for (Eigen::Index t = 0; t < tris.rows(); ++t) {
-    const Eigen::Vector3d a = f.mesh.nodes.row(tris(t, 0)), b = f.mesh.nodes.row(tris(t, 1)), c = f.mesh.nodes.row(tris(t, 2));
+    const Eigen::Vector3d a = f.mesh.nodes.row(tris(t, 0)), b = f.mesh.nodes.row(tris(t, 1)),
+                          c = f.mesh.nodes.row(tris(t, 2));
     face_area += 0.5 * (b - a).cross(c - a).norm();
   }
   for (int count : {1, 3, 7, 0}) {
@@ -82,7 +83,8 @@ TEST(ContactPatches, UniformRelativeDisplacementIsThePatchDisplacement) {
       u.segment<3>(3 * n.low) = b.cast<Complex>();
     }
     const Eigen::VectorXcd w = contact_rows(pairs, *f.sector, h, f.sector->n_full()) * u;
-    const Eigen::Vector3cd rel = a.cast<Complex>() - std::exp(Complex(0.0, h * alpha)) * (cyclic::rotation_z(alpha) * b).cast<Complex>();
+    const Eigen::Vector3cd rel =
+        a.cast<Complex>() - std::exp(Complex(0.0, h * alpha)) * (cyclic::rotation_z(alpha) * b).cast<Complex>();
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       ASSERT_GT(pairs[i].patch.size(), 1u);
       const Eigen::Vector3cd expected = pairs[i].frame.cast<Complex>() * rel;
@@ -150,11 +152,13 @@ TEST(ContactPatches, OnePairPerPatchIsTheNodeFormBitForBit) {
     const Eigen::SparseMatrix<Complex> c = contact_rows(weighted, *f.sector, h, f.sector->n_full());
     ASSERT_EQ(a.nonZeros(), c.nonZeros());
     EXPECT_EQ(std::memcmp(a.valuePtr(), c.valuePtr(), sizeof(Complex) * static_cast<std::size_t>(a.nonZeros())), 0);
-    EXPECT_EQ(std::memcmp(a.innerIndexPtr(), c.innerIndexPtr(), sizeof(int) * static_cast<std::size_t>(a.nonZeros())), 0);
+    EXPECT_EQ(std::memcmp(a.innerIndexPtr(), c.innerIndexPtr(), sizeof(int) * static_cast<std::size_t>(a.nonZeros())),
+              0);
   }
   // In the node form a patch acts at its seed only.
   const auto five = partition_face(f.mesh, f.face, 5);
-  for (const auto& p : contact_pairs(f.mesh, f.face, five, ContactDiscretization::nodes, 0.0)) EXPECT_TRUE(p.patch.empty());
+  for (const auto& p : contact_pairs(f.mesh, f.face, five, ContactDiscretization::nodes, 0.0))
+    EXPECT_TRUE(p.patch.empty());
 }
 
 TEST(ContactPatches, StuckPatchesThroughTheReceptancesEqualTheFESolveWithPatchSprings) {
@@ -176,8 +180,8 @@ TEST(ContactPatches, StuckPatchesThroughTheReceptancesEqualTheFESolveWithPatchSp
   auto r = modal::solve_harmonic(*f.sector, 0, mo);
   ASSERT_TRUE(r.report.ok()) << r.report.message;
   std::map<int, modal::ModalBasis> bases{{0, r.basis}};
-  const SectorLinearPart part(*f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); },
-                              pairs, forcing, 1);
+  const SectorLinearPart part(
+      *f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); }, pairs, forcing, 1);
   // Far below the first mode the receptance is the static flexibility (modes + residual
   // flexibility) up to (w / w_1)^2 of the modal part: 1e-6 here.
   const double w = 1e-3 * r.basis.omega[0];

@@ -158,8 +158,8 @@ TEST(SectorForced, EnergyBalanceAndOpenGapOnTheSector) {
   mo.modes = 15;
   std::map<int, modal::ModalBasis> bases;
   for (int h : {1, 2, 3}) bases[h] = modal::solve_harmonic(*f.sector, h, mo).basis;
-  const SectorLinearPart part(*f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); },
-                              pairs, forcing, 3);
+  const SectorLinearPart part(
+      *f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); }, pairs, forcing, 3);
   const double f_hz = 0.8 * bases.at(1).omega[0] / (2 * std::numbers::pi);
   for (const contact::Model model : {contact::Model::one_d, contact::Model::quasi3d}) {
     hbm::ContactEvaluatorOptions o;
@@ -227,8 +227,8 @@ TEST(SectorForced, HugeFrictionGivesTheLinearSectorWithContactSprings) {
   mo.modes = 20;
   std::map<int, modal::ModalBasis> bases;
   for (int h : {2, 4}) bases[h] = modal::solve_harmonic(*f.sector, h, mo).basis;
-  const SectorLinearPart part(*f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); },
-                              pairs, forcing, 2);
+  const SectorLinearPart part(
+      *f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); }, pairs, forcing, 2);
   const int h = 2;
   const double w = 0.4 * bases.at(h).omega[0];
   hbm::ContactEvaluatorOptions o;

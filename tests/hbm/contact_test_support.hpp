@@ -16,8 +16,8 @@ namespace shroudsim::testing {
 /// A random relative motion on the contact's own scale: tangential harmonics of amplitude
 /// U(0.2, 4) * mu N0/kt / n (from stick to gross slip), random phases and means; normal
 /// motion of amplitude U(0, 2) N0/kn / n (partial separation included). Seeded.
-inline Eigen::VectorXd random_contact_state(const hbm::HarmonicLayout& layout,
-                                            const contact::PairParameters& p, std::mt19937& rng) {
+inline Eigen::VectorXd random_contact_state(const hbm::HarmonicLayout& layout, const contact::PairParameters& p,
+                                            std::mt19937& rng) {
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   const double slip = p.friction_coefficient * std::abs(p.normal_preload) / p.tangential_stiffness;
   const double normal = std::abs(p.normal_preload) / p.normal_stiffness;

@@ -57,9 +57,9 @@ TEST_P(AftRoundTrip, TimeThenHarmonicsIsIdentityAndMatchesTheSeries) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, AftRoundTrip,
-                         ::testing::Values(std::pair{0, 1}, std::pair{1, 3}, std::pair{5, 11},
-                                           std::pair{5, 512}, std::pair{7, 15}, std::pair{15, 64},
-                                           std::pair{50, 101}, std::pair{50, 1024}));
+                         ::testing::Values(std::pair{0, 1}, std::pair{1, 3}, std::pair{5, 11}, std::pair{5, 512},
+                                           std::pair{7, 15}, std::pair{15, 64}, std::pair{50, 101},
+                                           std::pair{50, 1024}));
 
 // A^T diag(w) E from one FFT of w equals the direct product, also at N = 2H+1 where the
 // frequencies up to 2H wrap past N/2.

@@ -43,8 +43,8 @@ JenkinsRef jenkins_ref(double kt, double fs, double a) {
   return {kt * a / kPi * (beta - std::sin(2.0 * beta) / 2.0), -4.0 * fs / kPi * (1.0 - fs / (kt * a))};
 }
 
-const PairParameters kPair{.tangential_stiffness = 2e5, .normal_stiffness = 5e5,
-                           .friction_coefficient = 0.4, .normal_preload = 3.0};
+const PairParameters kPair{
+    .tangential_stiffness = 2e5, .normal_stiffness = 5e5, .friction_coefficient = 0.4, .normal_preload = 3.0};
 
 TEST(Jenkins, OneDExactEqualsTheClosedFormToRoundOff) {
   const double fs = kPair.friction_coefficient * kPair.normal_preload;
@@ -237,7 +237,8 @@ TEST(Limits, PureStickIsALinearSpringAndAGapThatNeverClosesIsNothing) {
   stick.friction_coefficient = 1e6;
   stick.normal_preload = 100.0;  // kn |z| <= 5e5 * 9 * 1e-7 = 0.45 N: never separates
   Eigen::VectorXd k(layout.size());
-  k << Eigen::VectorXd::Constant(2 * m, stick.tangential_stiffness), Eigen::VectorXd::Constant(m, stick.normal_stiffness);
+  k << Eigen::VectorXd::Constant(2 * m, stick.tangential_stiffness),
+      Eigen::VectorXd::Constant(m, stick.normal_stiffness);
   constexpr double kRoundOff = 1e-12;
   for (Model model : {Model::full3d, Model::quasi3d}) {
     for (auto update : {TangentialUpdate::radial_return, TangentialUpdate::exact_linear}) {

@@ -37,14 +37,15 @@ class StiffnessExtremes : public ::testing::TestWithParam<std::tuple<double, dou
 
 TEST_P(StiffnessExtremes, FiniteAndJacobianStillExact) {
   const auto [kt, kn, model, update] = GetParam();
-  const PairParameters p{.tangential_stiffness = kt, .normal_stiffness = kn,
-                         .friction_coefficient = 0.3, .normal_preload = 5.0};
+  const PairParameters p{
+      .tangential_stiffness = kt, .normal_stiffness = kn, .friction_coefficient = 0.3, .normal_preload = 5.0};
   constexpr int kStates = 8;
   ContactEvaluator ev(opts(model, update, 3, 64), std::vector<PairParameters>(kStates, p));
   std::mt19937 rng(99);
   const int s = ev.pair_layout().size();
   Eigen::VectorXd w(ev.size());
-  for (int i = 0; i < kStates; ++i) w.segment(i * s, s) = shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
+  for (int i = 0; i < kStates; ++i)
+    w.segment(i * s, s) = shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
   Eigen::VectorXd fa, ff;
   std::vector<Eigen::MatrixXd> ja, jf;
   EXPECT_EQ(ev.evaluate(w, fa, &ja, JacobianMethod::analytic).unconverged_pairs, 0);
@@ -84,17 +85,17 @@ TEST_P(StiffnessExtremes, FiniteAndJacobianStillExact) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Stiffness, StiffnessExtremes,
-    ::testing::Combine(::testing::Values(1e2, 1e12), ::testing::Values(1e2, 1e12),
-                       ::testing::Values(Model::full3d, Model::quasi3d),
-                       ::testing::Values(TangentialUpdate::radial_return, TangentialUpdate::exact_linear)));
+INSTANTIATE_TEST_SUITE_P(Stiffness, StiffnessExtremes,
+                         ::testing::Combine(::testing::Values(1e2, 1e12), ::testing::Values(1e2, 1e12),
+                                            ::testing::Values(Model::full3d, Model::quasi3d),
+                                            ::testing::Values(TangentialUpdate::radial_return,
+                                                              TangentialUpdate::exact_linear)));
 
 TEST(FrictionExtremes, MuZeroGivesNoTangentialForceMuHugeIsLinear) {
   const int h = 3, n = 64;
   for (auto update : {TangentialUpdate::radial_return, TangentialUpdate::exact_linear}) {
-    PairParameters p{.tangential_stiffness = 1e6, .normal_stiffness = 1e6, .friction_coefficient = 0.0,
-                     .normal_preload = 1.0};
+    PairParameters p{
+        .tangential_stiffness = 1e6, .normal_stiffness = 1e6, .friction_coefficient = 0.0, .normal_preload = 1.0};
     ContactEvaluator ev(opts(Model::full3d, update, h, n), {p});
     const int m = ev.pair_layout().per_direction();
     Eigen::VectorXd w = Eigen::VectorXd::Zero(ev.size());
@@ -121,8 +122,8 @@ TEST(PreloadExtremes, ZeroPreloadAndAGapThatNeverCloses) {
   const int h = 4, n = 2048;
   // N0 = 0 with z = z1 cos t: contact exactly half the period, N = kn z1 max(0, cos t):
   // F0 = A/pi, F1 = A/2, F2 = 2A/(3 pi) (clipped cosine at al = pi/2).
-  PairParameters p{.tangential_stiffness = 1e6, .normal_stiffness = 1e6, .friction_coefficient = 0.3,
-                   .normal_preload = 0.0};
+  PairParameters p{
+      .tangential_stiffness = 1e6, .normal_stiffness = 1e6, .friction_coefficient = 0.3, .normal_preload = 0.0};
   ContactEvaluator ev(opts(Model::full3d, TangentialUpdate::exact_linear, h, n), {p});
   const int m = ev.pair_layout().per_direction();
   Eigen::VectorXd w = Eigen::VectorXd::Zero(ev.size());
@@ -133,7 +134,7 @@ TEST(PreloadExtremes, ZeroPreloadAndAGapThatNeverCloses) {
   EXPECT_EQ(ev.evaluate(w, f, &j).unconverged_pairs, 0);
   ASSERT_TRUE(f.allFinite());
   ASSERT_TRUE(j[0].allFinite());
-  const double amp = 1.0;  // kn z1 [N]
+  const double amp = 1.0;                                     // kn z1 [N]
   const double tol = 2.0 * std::pow(2.0 * kPi / n, 2) * amp;  // kink sampled: O(h^2)
   EXPECT_NEAR(f[2 * m], amp / kPi, tol);
   EXPECT_NEAR(f[2 * m + 1], amp / 2.0, tol);
@@ -150,8 +151,8 @@ TEST(PreloadExtremes, ZeroPreloadAndAGapThatNeverCloses) {
 }
 
 TEST(SamplingExtremes, MinimumSamplesAndFiftyHarmonics) {
-  const PairParameters p{.tangential_stiffness = 2e5, .normal_stiffness = 5e5, .friction_coefficient = 0.4,
-                         .normal_preload = 3.0};
+  const PairParameters p{
+      .tangential_stiffness = 2e5, .normal_stiffness = 5e5, .friction_coefficient = 0.4, .normal_preload = 3.0};
   for (auto [h, n] : {std::pair{5, 11}, std::pair{50, 101}, std::pair{50, 256}}) {
     for (auto update : {TangentialUpdate::radial_return, TangentialUpdate::exact_linear}) {
       ContactEvaluator ev(opts(Model::full3d, update, h, n), {p, p});
@@ -180,8 +181,8 @@ TEST(SamplingExtremes, MinimumSamplesAndFiftyHarmonics) {
 
 TEST(AmplitudeExtremes, PicometreSticksMetreSlipsGrossly) {
   // kt = 1e6 N/m, Fs = 0.075 N: slip starts at 7.5e-8 m.
-  const PairParameters p{.tangential_stiffness = 1e6, .normal_stiffness = 1e6, .friction_coefficient = 0.3,
-                         .normal_preload = 0.25};
+  const PairParameters p{
+      .tangential_stiffness = 1e6, .normal_stiffness = 1e6, .friction_coefficient = 0.3, .normal_preload = 0.25};
   const double fs = 0.075;
   for (Model model : {Model::one_d, Model::full3d}) {
     for (auto update : {TangentialUpdate::radial_return, TangentialUpdate::exact_linear}) {

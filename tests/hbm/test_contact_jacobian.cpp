@@ -40,12 +40,12 @@ shroudsim::contact::PairParameters test_pair() {
 }
 
 // One seeded random state per pair of ev (all pairs with parameters p).
-Eigen::VectorXd random_states(const ContactEvaluator& ev, const shroudsim::contact::PairParameters& p,
-                              unsigned seed) {
+Eigen::VectorXd random_states(const ContactEvaluator& ev, const shroudsim::contact::PairParameters& p, unsigned seed) {
   std::mt19937 rng(seed);
   Eigen::VectorXd w(ev.size());
   const int s = ev.pair_layout().size();
-  for (int k = 0; k < ev.n_pairs(); ++k) w.segment(k * s, s) = shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
+  for (int k = 0; k < ev.n_pairs(); ++k)
+    w.segment(k * s, s) = shroudsim::testing::random_contact_state(ev.pair_layout(), p, rng);
   return w;
 }
 
@@ -92,17 +92,16 @@ TEST_P(JacobianVsFd, MatchesCentralDifferences) {
   EXPECT_GE(within, kShareRequired * kStates);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Models, JacobianVsFd,
-    ::testing::Values(std::tuple{Model::full3d, TangentialUpdate::radial_return, 3, 64},
-                      std::tuple{Model::full3d, TangentialUpdate::exact_linear, 3, 64},
-                      std::tuple{Model::quasi3d, TangentialUpdate::radial_return, 3, 64},
-                      std::tuple{Model::quasi3d, TangentialUpdate::exact_linear, 3, 64},
-                      std::tuple{Model::one_d, TangentialUpdate::radial_return, 3, 64},
-                      std::tuple{Model::one_d, TangentialUpdate::exact_linear, 3, 64},
-                      std::tuple{Model::full3d, TangentialUpdate::exact_linear, 1, 256},
-                      std::tuple{Model::full3d, TangentialUpdate::radial_return, 5, 128},
-                      std::tuple{Model::one_d_exact, TangentialUpdate::exact_linear, 1, 64}));
+INSTANTIATE_TEST_SUITE_P(Models, JacobianVsFd,
+                         ::testing::Values(std::tuple{Model::full3d, TangentialUpdate::radial_return, 3, 64},
+                                           std::tuple{Model::full3d, TangentialUpdate::exact_linear, 3, 64},
+                                           std::tuple{Model::quasi3d, TangentialUpdate::radial_return, 3, 64},
+                                           std::tuple{Model::quasi3d, TangentialUpdate::exact_linear, 3, 64},
+                                           std::tuple{Model::one_d, TangentialUpdate::radial_return, 3, 64},
+                                           std::tuple{Model::one_d, TangentialUpdate::exact_linear, 3, 64},
+                                           std::tuple{Model::full3d, TangentialUpdate::exact_linear, 1, 256},
+                                           std::tuple{Model::full3d, TangentialUpdate::radial_return, 5, 128},
+                                           std::tuple{Model::one_d_exact, TangentialUpdate::exact_linear, 1, 64}));
 
 // Block diagonal and parallel: evaluating pairs together, threaded, equals one at a time.
 TEST(ContactEvaluator, PairsAreIndependentAndThreadingChangesNothing) {

@@ -62,7 +62,8 @@ TEST_P(SectorOrders, HasEveryGroupAndMatchedFaces) {
   for (const auto& [pairs, low, high] :
        {std::tuple{&m.cyclic_pairs, kCyclicLow, kCyclicHigh}, std::tuple{&m.shroud_pairs, kShroudLow, kShroudHigh}}) {
     ASSERT_EQ(pairs->size(), m.node_sets.at(low).size());
-    const NodeMatch match = match_rotated_nodes(m.nodes, m.node_sets.at(low), m.node_sets.at(high), alpha, kRoundOff * size);
+    const NodeMatch match =
+        match_rotated_nodes(m.nodes, m.node_sets.at(low), m.node_sets.at(high), alpha, kRoundOff * size);
     EXPECT_TRUE(match.complete) << low << " worst " << match.worst_distance;
     EXPECT_LT(match.worst_distance, kRoundOff * size);
   }
@@ -79,8 +80,8 @@ TEST_P(SectorOrders, HasEveryGroupAndMatchedFaces) {
 
 TEST_P(SectorOrders, VolumeMatchesTheAnalyticVolume) {
   SectorGeometry g = coarse(GetParam());
-  g.blade_twist_deg = 0.0;   // analytic_volume() is exact without twist
-  g.shroud_width = 0.06;     // an untwisted tip needs room within the shroud
+  g.blade_twist_deg = 0.0;  // analytic_volume() is exact without twist
+  g.shroud_width = 0.06;    // an untwisted tip needs room within the shroud
   const Mesh m = generate_and_read(g, "volume" + std::to_string(GetParam()) + ".msh");
   const double exact = g.analytic_volume();
   const double meshed = element_quality(m).volume;

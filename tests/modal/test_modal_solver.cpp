@@ -37,7 +37,7 @@ const cyclic::CyclicSector& bladed_sector() {
 Eigen::VectorXd dense_frequencies(const cyclic::CyclicSector& sector, int h) {
   const auto km = sector.reduce(h);
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXcd> es(Eigen::MatrixXcd(km.K), Eigen::MatrixXcd(km.M),
-                                                                 Eigen::EigenvaluesOnly);
+                                                                Eigen::EigenvaluesOnly);
   return es.eigenvalues().cwiseSqrt();
 }
 
@@ -141,7 +141,8 @@ template <typename S>
 void expect_grid_spectrum(int N, int modes, EigenMethod method) {
   std::vector<double> exact;
   for (int i = 1; i <= N; ++i)
-    for (int j = 1; j <= N; ++j) exact.push_back(4 - 2 * std::cos(i * M_PI / (N + 1)) - 2 * std::cos(j * M_PI / (N + 1)));
+    for (int j = 1; j <= N; ++j)
+      exact.push_back(4 - 2 * std::cos(i * M_PI / (N + 1)) - 2 * std::cos(j * M_PI / (N + 1)));
   std::sort(exact.begin(), exact.end());
   ModalOptions o;
   o.modes = modes;
@@ -200,8 +201,8 @@ TEST(SolveHarmonic, UnconvergedLanczosIsReportedNotReturned) {
   ModalOptions options;
   options.method = EigenMethod::Spectra;
   options.modes = 20;
-  options.ncv = 45;           // barely above nev = 44 for the 2n problem
-  options.max_restarts = 1;   // cannot converge 44 Ritz pairs in one sweep
+  options.ncv = 45;          // barely above nev = 44 for the 2n problem
+  options.max_restarts = 1;  // cannot converge 44 Ritz pairs in one sweep
   const ModalResult r = solve_harmonic(sector, 1, options);
   EXPECT_EQ(r.report.status, ModalStatus::NotConverged);
   EXPECT_FALSE(r.report.message.empty());
@@ -288,7 +289,7 @@ TEST(ModalCache, CorruptedBytesAreDetectedAtEveryOffset) {
       std::ofstream(file, std::ios::binary | std::ios::trunc) << bad;
       std::string problem;
       const bool used = std::string(name) == "km.bin" ? load_matrices(file, "k", &problem).has_value()
-                                                       : load_basis(file, "k", &problem).has_value();
+                                                      : load_basis(file, "k", &problem).has_value();
       EXPECT_FALSE(used) << name << " byte " << at;
       EXPECT_FALSE(problem.empty()) << name << " byte " << at;
       ++checked;

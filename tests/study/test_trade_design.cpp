@@ -20,9 +20,9 @@ TEST(TradeDesign, AGeneratedSectorVariesEveryKnobAndItsMeshDoublesTheDofsPerStep
   c.geometry.mesh_size = 0.02;
   c.contact.pairs = 5;
   const auto knobs = study::convergence_knobs(c);
-  for (const char* key : {"geometry.mesh_size", "contact.pairs", "modal.modes", "modal.residual_flexibility",
-                          "hbm.harmonics", "hbm.time_samples", "contact.tangential_update", "contact.model",
-                          "hbm.jacobian"})
+  for (const char* key :
+       {"geometry.mesh_size", "contact.pairs", "modal.modes", "modal.residual_flexibility", "hbm.harmonics",
+        "hbm.time_samples", "contact.tangential_update", "contact.model", "hbm.jacobian"})
     EXPECT_NE(find(knobs, key), nullptr) << key;
   const study::Knob* mesh = find(knobs, "geometry.mesh_size");
   ASSERT_EQ(mesh->values.size(), static_cast<std::size_t>(study::kMeshLadder));
