@@ -44,6 +44,11 @@ namespace {
 constexpr double kSingular = 1e-10;
 // Plain periods before the Newton iteration of the coupled model starts (see run()).
 constexpr int kPlainPeriods = 4;
+// Halvings of a Newton step that does not reduce max|g| before the plain repetition is taken
+// (see run()). Landing off a bent slow direction costs ~ the step squared, so each halving
+// cuts that by 4; one halving sufficed in the wheel state of issue 13 (measured), and 4 (down to
+// 1/16 of the step) bound the cost of a rejected step at 5 periods.
+constexpr int kNewtonHalvings = 4;
 bool pseudo_inverse2(const Eigen::Matrix2d& a, Eigen::Matrix2d& inv) {
   if (!a.allFinite()) return false;
   const Eigen::JacobiSVD<Eigen::Matrix2d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -123,7 +128,12 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
   // a small oscillation: ~0.998 per period): safeguarded Newton on g(d) = Phi(d) - d from where
   // the plain periods ended, forces-only periods carrying Phi_d. A Newton step is accepted
   // when it reduces max|g| (Phi is strongly curved far from d*: the first steps reduce |g| by
-  // ~2, the last ones quadratically), else the plain repetition d <- Phi(d) is taken.
+  // ~2, the last ones quadratically); if it does not, it is halved up to kNewtonHalvings
+  // times, and only then is the plain repetition d <- Phi(d) taken. The halving matters where
+  // Phi contracts strongly across a slow direction that bends (two short slips per period
+  // that nearly cancel, issue 13): the full step follows the slow direction's tangent and
+  // lands off the bent curve, where the strong contraction makes |g| larger than at the
+  // start, although the step is mostly right; a shorter one lands closer to the curve.
   std::array<double, 2> dk{0.0, 0.0};  // accepted iterate
   auto pass = [&](const std::array<double, 2>& start) {
     d_ = start;
@@ -151,21 +161,26 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
       // Newton: g(dk + delta) ~ g + (Phi_d - I) delta = 0.
       Eigen::Matrix2d ai;
       if (pseudo_inverse2(Eigen::Matrix2d::Identity() - jk, ai)) {
-        const Eigen::Vector2d delta = ai * Eigen::Vector2d(g[0], g[1]);
-        const std::array<double, 2> trial{dk[0] + delta.x(), dk[1] + delta.y()};
-        if (std::isfinite(trial[0]) && std::isfinite(trial[1]) && (delta.x() != 0.0 || delta.y() != 0.0)) {
+        Eigen::Vector2d delta = ai * Eigen::Vector2d(g[0], g[1]);
+        bool accepted = false;
+        // The full step first, then shortened ones (see kNewtonHalvings).
+        for (int h = 0; h <= kNewtonHalvings && status.periods < options_.max_periods; ++h, delta *= 0.5) {
+          const std::array<double, 2> trial{dk[0] + delta.x(), dk[1] + delta.y()};
+          if (!std::isfinite(trial[0]) || !std::isfinite(trial[1]) || (delta.x() == 0.0 && delta.y() == 0.0)) break;
           const std::array<double, 2> gt = pass(trial);
           const double gtn = std::max(std::abs(gt[0]), std::abs(gt[1]));
-          if (gtn <= tol || gtn < gn) {  // accepted
+          if (gtn <= tol || gtn < gn) {
             dk = trial;
             g = gt;
             gn = gtn;
             jk = dd_start_;
             slipped = slipped_;
-            continue;
+            accepted = true;
+            break;
           }
-          if (status.periods >= options_.max_periods) break;
         }
+        if (accepted) continue;
+        if (status.periods >= options_.max_periods) break;
       }
     }
     // Safeguard: plain repetition, dk <- Phi(dk) = dk + g.

@@ -13,8 +13,9 @@
 //    safeguarded Newton iteration on g(d) = Phi(d) - d from there, with the 2x2 derivative
 //    Phi_d carried through each period (contraction where the pair slips, the identity in
 //    pure stick where every d is periodic and d = 0 is kept; exactly neutral directions are
-//    left alone): a Newton step is accepted when it reduces max|g|, else the plain
-//    repetition d <- Phi(d) is taken.
+//    left alone): a Newton step is accepted when it reduces max|g|, else it is halved (up
+//    to 4 times) and, if none of those reduces max|g| either, the plain repetition
+//    d <- Phi(d) is taken.
 // Both stop when |d_end - d_start| <= period_tolerance * max_l |w_t(l)| for the returned
 // period (the last one computed, started from the accepted iterate), capped by max_periods
 // periods; the status says whether it converged. Deterministic: same input, same iterates.
