@@ -58,8 +58,8 @@ struct PairParameters {
 struct LawOptions {
   Model model = Model::full3d;
   TangentialUpdate update = TangentialUpdate::exact_linear;
-  int max_periods = 200;             ///< cap on repeated periods, >= 1
-  double period_tolerance = 1e-12;   ///< relative repeat tolerance of d, in (0, 1e-3]
+  int max_periods = 200;            ///< cap on repeated periods, >= 1
+  double period_tolerance = 1e-12;  ///< relative repeat tolerance of d, in (0, 1e-3]
 
   bool validate(std::vector<std::string>* errors) const;
 };

@@ -87,8 +87,8 @@ S log1p_over(const S& y) {
 //    K = |dw| int_{s*}^1 ds/a(s) = |dw| (1 - s*)/a(s*) * ln(1 + y)/y,  y = (1 - s*) da/a(s*),
 //  and slip persists once started (g'(s*) >= 0 means dw.e >= a da, and cos(phi) grows).
 template <class S>
-void exact_linear_step_t(S e0x, S e0y, const S& dwx, const S& dwy, const S& a0, const S& a1,
-                         S& e1x, S& e1y, bool& stuck) {
+void exact_linear_step_t(S e0x, S e0y, const S& dwx, const S& dwy, const S& a0, const S& a1, S& e1x, S& e1y,
+                         bool& stuck) {
   stuck = false;
   // Start state inside the start circle (it is, up to round-off, by construction).
   const S n0sq = e0x * e0x + e0y * e0y;
@@ -149,8 +149,8 @@ void exact_linear_step_t(S e0x, S e0y, const S& dwx, const S& dwy, const S& a0, 
   const S esy = e0y + s * dwy;
   const S esn = sqrt(esx * esx + esy * esy);
   const S ux = esx / esn, uy = esy / esn;
-  const S c0 = qx * ux + qy * uy;  // cos(phi0)
-  const S s0 = qy * ux - qx * uy;  // sin(phi0), phi0 = q - p0
+  const S c0 = qx * ux + qy * uy;           // cos(phi0)
+  const S s0 = qy * ux - qx * uy;           // sin(phi0), phi0 = q - p0
   if (val(c0) <= -0.5 && val(s0) == 0.0) {  // phi0 = pi: stays opposite to the motion
     e1x = -(a1 * qx);
     e1y = -(a1 * qy);
@@ -184,8 +184,8 @@ inline Dual seed(double value, int index) {
 
 }  // namespace
 
-Eigen::Vector2d exact_linear_step(const Eigen::Vector2d& e0, const Eigen::Vector2d& dw, double a,
-                                  double a_end, Eigen::Matrix<double, 2, 6>* jac, bool* stuck) {
+Eigen::Vector2d exact_linear_step(const Eigen::Vector2d& e0, const Eigen::Vector2d& dw, double a, double a_end,
+                                  Eigen::Matrix<double, 2, 6>* jac, bool* stuck) {
   bool stuck_local = false;
   bool& st = stuck ? *stuck : stuck_local;
   SHROUDSIM_ASSERT(a >= 0.0 && a_end > 0.0, "exact_linear_step needs a0 >= 0, a1 > 0");
@@ -195,8 +195,8 @@ Eigen::Vector2d exact_linear_step(const Eigen::Vector2d& e0, const Eigen::Vector
     return {e1x, e1y};
   }
   Dual e1x, e1y;
-  exact_linear_step_t<Dual>(seed(e0.x(), 0), seed(e0.y(), 1), seed(dw.x(), 2), seed(dw.y(), 3),
-                          seed(a, 4), seed(a_end, 5), e1x, e1y, st);
+  exact_linear_step_t<Dual>(seed(e0.x(), 0), seed(e0.y(), 1), seed(dw.x(), 2), seed(dw.y(), 3), seed(a, 4),
+                            seed(a_end, 5), e1x, e1y, st);
   for (int i = 0; i < kNd; ++i) {
     (*jac)(0, i) = e1x.g[i];
     (*jac)(1, i) = e1y.g[i];

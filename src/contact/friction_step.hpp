@@ -57,9 +57,8 @@ inline RadialReturn radial_return(double wx, double wy, std::array<double, 2>& d
 /// Returns e1 = w_t(l) - d(l), |e1| <= a1; if jac != nullptr, also
 /// de1/d(e0x, e0y, dwx, dwy, a0, a1) (2 x 6).
 /// stuck (optional): set when the whole step sticks from an admissible start (e1 = e0 + dw).
-Eigen::Vector2d exact_linear_step(const Eigen::Vector2d& e0, const Eigen::Vector2d& dw, double a0,
-                                  double a1, Eigen::Matrix<double, 2, 6>* jac = nullptr,
-                                  bool* stuck = nullptr);
+Eigen::Vector2d exact_linear_step(const Eigen::Vector2d& e0, const Eigen::Vector2d& dw, double a0, double a1,
+                                  Eigen::Matrix<double, 2, 6>* jac = nullptr, bool* stuck = nullptr);
 
 /// One sample of a 1D law. d: the damper position of the axis, advanced in place.
 struct AxisStep {

@@ -6,8 +6,7 @@
 
 namespace shroudsim::contact {
 
-JenkinsHarmonics jenkins_single_harmonic(double kt, double slip_force, double c0, double c1,
-                                         double s1) {
+JenkinsHarmonics jenkins_single_harmonic(double kt, double slip_force, double c0, double c1, double s1) {
   constexpr double kPi = std::numbers::pi;
   JenkinsHarmonics h;
   const double a = std::hypot(c1, s1);

@@ -14,17 +14,16 @@
 namespace shroudsim::contact {
 
 struct JenkinsHarmonics {
-  double f0 = 0.0;  ///< mean force [N]
-  double fc = 0.0;  ///< cos(theta) coefficient [N]
-  double fs = 0.0;  ///< sin(theta) coefficient [N]
+  double f0 = 0.0;                                     ///< mean force [N]
+  double fc = 0.0;                                     ///< cos(theta) coefficient [N]
+  double fs = 0.0;                                     ///< sin(theta) coefficient [N]
   Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();  ///< d(f0, fc, fs)/d(c0, c1, s1) [N/m]
   bool stick = true;
 };
 
 /// First-harmonic (and mean) coefficients of the steady Jenkins force, with their exact
 /// derivatives. kt > 0, slip_force >= 0.
-JenkinsHarmonics jenkins_single_harmonic(double kt, double slip_force, double c0, double c1,
-                                         double s1);
+JenkinsHarmonics jenkins_single_harmonic(double kt, double slip_force, double c0, double c1, double s1);
 
 /// The steady time-continuous Jenkins force at phase theta [rad].
 double jenkins_force(double kt, double slip_force, double c0, double c1, double s1, double theta);

@@ -52,9 +52,8 @@ PeriodRecorder::PeriodRecorder(LinearizedPeriod& lin, int samples, int slip_dire
   }
 }
 
-void PeriodRecorder::radial_return_slip(const Eigen::MatrixXd& basis, int l, double kt, double kn, double mu,
-                                        double ex, double ey, double rho, Eigen::RowVectorXd& x,
-                                        Eigen::RowVectorXd& y) {
+void PeriodRecorder::radial_return_slip(const Eigen::MatrixXd& basis, int l, double kt, double kn, double mu, double ex,
+                                        double ey, double rho, Eigen::RowVectorXd& x, Eigen::RowVectorXd& y) {
   // One fused pass over the P columns, written straight into the dense rows of this sample.
   const int n = static_cast<int>(basis.rows());
   const int m = static_cast<int>(basis.cols());
@@ -88,8 +87,8 @@ void PeriodRecorder::radial_return_slip(const Eigen::MatrixXd& basis, int l, dou
 }
 
 void PeriodRecorder::exact_linear_slip(const Eigen::MatrixXd& basis, int l, int lp, double kt, double kn, double mu,
-                                       bool pressed_prev, const Eigen::Matrix<double, 2, 6>& jl,
-                                       Eigen::RowVectorXd& x, Eigen::RowVectorXd& y) {
+                                       bool pressed_prev, const Eigen::Matrix<double, 2, 6>& jl, Eigen::RowVectorXd& x,
+                                       Eigen::RowVectorXd& y) {
   const int n = static_cast<int>(basis.rows());
   const int m = static_cast<int>(basis.cols());
   const double ca = mu * kn / kt;

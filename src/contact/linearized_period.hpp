@@ -44,13 +44,13 @@ struct LinearizedPeriod {
     double alpha = 0.0, beta = 0.0;
   };
   std::array<std::vector<Run>, 2> runs;
-  std::array<RowMatrix, 2> run_x;           ///< capacity N rows; row r: X_i in run r (P)
+  std::array<RowMatrix, 2> run_x;  ///< capacity N rows; row r: X_i in run r (P)
   std::array<std::vector<int>, 2> dense_index;
-  std::array<RowMatrix, 2> dense;           ///< capacity N rows; row k: dT_i (P)
+  std::array<RowMatrix, 2> dense;                  ///< capacity N rows; row k: dT_i (P)
   std::array<std::vector<double>, 2> slip_weight;  ///< N each for uncoupled models, else empty
-  std::vector<unsigned char> pressed;       ///< N flags (all 0 for the 1d model)
-  double kt = 0.0, kn = 0.0;                ///< [N/m]
-  int p = 0;                                ///< unknowns
+  std::vector<unsigned char> pressed;              ///< N flags (all 0 for the 1d model)
+  double kt = 0.0, kn = 0.0;                       ///< [N/m]
+  int p = 0;                                       ///< unknowns
 
   /// dF_i(l)/dc as N x P matrices, i = x, y, z (for tests and inspection).
   void expand(const Eigen::MatrixXd& basis, std::array<RowMatrix, 3>& df) const;
@@ -89,8 +89,7 @@ class PeriodRecorder {
     auto& runs = lin_.runs[i];
     if (!prev_stick_[i] || runs.back().anchor != s || runs.back().alpha != alpha || runs.back().beta != beta)
       runs.push_back({l, l, s, alpha, beta});
-    else
-      runs.back().last = l;
+    else runs.back().last = l;
     prev_stick_[i] = true;
   }
   /// Uncoupled slip of direction i at l: dT_i(l)/dc = weight E_z(l).

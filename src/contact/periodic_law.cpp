@@ -21,9 +21,8 @@ PeriodicLaw::PeriodicLaw(LawOptions options) : options_(options) {
         "contact::PeriodicLaw: model 1d_exact is time-continuous (use jenkins_single_harmonic)");
 }
 
-PeriodicStatus PeriodicLaw::evaluate(const PairParameters& pair, const Eigen::MatrixX3d& w,
-                                     Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
-                                     LinearizedPeriod* lin) {
+PeriodicStatus PeriodicLaw::evaluate(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
+                                     const Eigen::MatrixXd* basis, LinearizedPeriod* lin) {
   SHROUDSIM_CHECK((basis == nullptr) == (lin == nullptr), "basis and lin go together");
   SHROUDSIM_CHECK(w.rows() >= 1, "at least one sample");
   if (basis != nullptr) {
@@ -44,6 +43,11 @@ namespace {
 constexpr double kSingular = 1e-10;
 // Plain periods before the Newton iteration of the coupled model starts (see run()).
 constexpr int kPlainPeriods = 4;
+// Halvings of a Newton step that does not reduce max|g| before the plain repetition is taken
+// (see run()). Landing off a bent slow direction costs ~ the step squared, so each halving
+// cuts that by 4; one halving sufficed in the wheel state of issue 13 (measured), and 4 (down to
+// 1/16 of the step) bound the cost of a rejected step at 5 periods.
+constexpr int kNewtonHalvings = 4;
 bool pseudo_inverse2(const Eigen::Matrix2d& a, Eigen::Matrix2d& inv) {
   if (!a.allFinite()) return false;
   const Eigen::JacobiSVD<Eigen::Matrix2d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -58,9 +62,8 @@ bool pseudo_inverse2(const Eigen::Matrix2d& a, Eigen::Matrix2d& inv) {
 }  // namespace
 
 template <bool kD>
-PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX3d& w,
-                                Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
-                                LinearizedPeriod* lin) {
+PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
+                                const Eigen::MatrixXd* basis, LinearizedPeriod* lin) {
   const int n = static_cast<int>(w.rows());
   const Model model = options_.model;
   const bool two_d = model != Model::one_d;
@@ -123,7 +126,12 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
   // a small oscillation: ~0.998 per period): safeguarded Newton on g(d) = Phi(d) - d from where
   // the plain periods ended, forces-only periods carrying Phi_d. A Newton step is accepted
   // when it reduces max|g| (Phi is strongly curved far from d*: the first steps reduce |g| by
-  // ~2, the last ones quadratically), else the plain repetition d <- Phi(d) is taken.
+  // ~2, the last ones quadratically); if it does not, it is halved up to kNewtonHalvings
+  // times, and only then is the plain repetition d <- Phi(d) taken. The halving matters where
+  // Phi contracts strongly across a slow direction that bends (two short slips per period
+  // that nearly cancel, issue 13): the full step follows the slow direction's tangent and
+  // lands off the bent curve, where the strong contraction makes |g| larger than at the
+  // start, although the step is mostly right; a shorter one lands closer to the curve.
   std::array<double, 2> dk{0.0, 0.0};  // accepted iterate
   auto pass = [&](const std::array<double, 2>& start) {
     d_ = start;
@@ -151,21 +159,26 @@ PeriodicStatus PeriodicLaw::run(const PairParameters& pair, const Eigen::MatrixX
       // Newton: g(dk + delta) ~ g + (Phi_d - I) delta = 0.
       Eigen::Matrix2d ai;
       if (pseudo_inverse2(Eigen::Matrix2d::Identity() - jk, ai)) {
-        const Eigen::Vector2d delta = ai * Eigen::Vector2d(g[0], g[1]);
-        const std::array<double, 2> trial{dk[0] + delta.x(), dk[1] + delta.y()};
-        if (std::isfinite(trial[0]) && std::isfinite(trial[1]) && (delta.x() != 0.0 || delta.y() != 0.0)) {
+        Eigen::Vector2d delta = ai * Eigen::Vector2d(g[0], g[1]);
+        bool accepted = false;
+        // The full step first, then shortened ones (see kNewtonHalvings).
+        for (int h = 0; h <= kNewtonHalvings && status.periods < options_.max_periods; ++h, delta *= 0.5) {
+          const std::array<double, 2> trial{dk[0] + delta.x(), dk[1] + delta.y()};
+          if (!std::isfinite(trial[0]) || !std::isfinite(trial[1]) || (delta.x() == 0.0 && delta.y() == 0.0)) break;
           const std::array<double, 2> gt = pass(trial);
           const double gtn = std::max(std::abs(gt[0]), std::abs(gt[1]));
-          if (gtn <= tol || gtn < gn) {  // accepted
+          if (gtn <= tol || gtn < gn) {
             dk = trial;
             g = gt;
             gn = gtn;
             jk = dd_start_;
             slipped = slipped_;
-            continue;
+            accepted = true;
+            break;
           }
-          if (status.periods >= options_.max_periods) break;
         }
+        if (accepted) continue;
+        if (status.periods >= options_.max_periods) break;
       }
     }
     // Safeguard: plain repetition, dk <- Phi(dk) = dk + g.
@@ -210,8 +223,8 @@ struct PeriodicLaw::Sample {
 // a large part of the cost of a forces-only evaluation.
 
 template <bool kD>
-[[gnu::always_inline]] inline
-void PeriodicLaw::separate(const Sample& s, const Eigen::MatrixXd* basis, PeriodRecorder* rec, bool track) {
+[[gnu::always_inline]] inline void PeriodicLaw::separate(const Sample& s, const Eigen::MatrixXd* basis,
+                                                         PeriodRecorder* rec, bool track) {
   d_ = {s.wx, s.wy};
   if constexpr (kD) {
     rec->release(0);
@@ -235,8 +248,7 @@ void PeriodicLaw::separate(const Sample& s, const Eigen::MatrixXd* basis, Period
 }
 
 template <bool kD>
-[[gnu::always_inline]] inline
-void PeriodicLaw::record_coupled_stick(int l, PeriodRecorder* rec, bool track) {
+[[gnu::always_inline]] inline void PeriodicLaw::record_coupled_stick(int l, PeriodRecorder* rec, bool track) {
   // dT = kt (dw_t - dd), dd unchanged: the runs' damper derivative is the current one.
   if constexpr (kD) {
     if (rec->stick(0, l, xd_) && track) run_d_[0].push_back(dd_start_);
@@ -245,18 +257,15 @@ void PeriodicLaw::record_coupled_stick(int l, PeriodRecorder* rec, bool track) {
 }
 
 template <bool kD>
-[[gnu::always_inline]] inline
-void PeriodicLaw::track_coupled_slip(const Eigen::Matrix2d& md, double kt) {
+[[gnu::always_inline]] inline void PeriodicLaw::track_coupled_slip(const Eigen::Matrix2d& md, double kt) {
   if constexpr (kD) dense_q_.push_back(-kt * md);
   dd_start_ = md;
   slipped_ = true;
 }
 
 template <bool kD>
-[[gnu::always_inline]] inline
-std::array<double, 2> PeriodicLaw::coupled_radial_return(const PairParameters& pair, const Sample& s,
-                                                         const Eigen::MatrixXd* basis, PeriodRecorder* rec,
-                                                         bool track) {
+[[gnu::always_inline]] inline std::array<double, 2> PeriodicLaw::coupled_radial_return(
+    const PairParameters& pair, const Sample& s, const Eigen::MatrixXd* basis, PeriodRecorder* rec, bool track) {
   const double kt = pair.tangential_stiffness;
   const RadialReturn r = radial_return(s.wx, s.wy, d_, kt, s.lim);
   if (r.stick) {
@@ -277,10 +286,10 @@ std::array<double, 2> PeriodicLaw::coupled_radial_return(const PairParameters& p
 }
 
 template <bool kD>
-[[gnu::always_inline]] inline
-std::array<double, 2> PeriodicLaw::coupled_exact_linear(const PairParameters& pair, const Sample& s,
-                                                        const Eigen::MatrixXd* basis, PeriodRecorder* rec,
-                                                        bool track) {
+[[gnu::always_inline]] inline std::array<double, 2> PeriodicLaw::coupled_exact_linear(const PairParameters& pair,
+                                                                                      const Sample& s,
+                                                                                      const Eigen::MatrixXd* basis,
+                                                                                      PeriodRecorder* rec, bool track) {
   // Elastic displacement e = w_t - d integrated over the step, slip radius linear within the
   // step, from mu N(l-1)/kt to mu N(l)/kt.
   const double kt = pair.tangential_stiffness;
@@ -310,8 +319,8 @@ std::array<double, 2> PeriodicLaw::coupled_exact_linear(const PairParameters& pa
 }
 
 template <bool kD>
-[[gnu::always_inline]] inline
-std::array<double, 2> PeriodicLaw::uncoupled(const PairParameters& pair, const Sample& s, PeriodRecorder* rec) {
+[[gnu::always_inline]] inline std::array<double, 2> PeriodicLaw::uncoupled(const PairParameters& pair, const Sample& s,
+                                                                           PeriodRecorder* rec) {
   // quasi3d (x and y) or 1d (x): independent 1D laws with limit mu N(l). Their slip is
   // memoryless, so the damper derivative is always X_i = alpha E_i(s) + beta E_z(s) for
   // the last slip or separation sample s (an "anchor"; 0 before any): no P-wide rows.
@@ -353,9 +362,8 @@ std::array<double, 2> PeriodicLaw::uncoupled(const PairParameters& pair, const S
 }
 
 template <bool kD>
-void PeriodicLaw::period(const PairParameters& pair, const Eigen::MatrixX3d& w,
-                         Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
-                         LinearizedPeriod* lin, bool track) {
+void PeriodicLaw::period(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
+                         const Eigen::MatrixXd* basis, LinearizedPeriod* lin, bool track) {
   const int n = static_cast<int>(w.rows());
   const Model model = options_.model;
   const bool two_d = model != Model::one_d;
@@ -398,25 +406,19 @@ void PeriodicLaw::period(const PairParameters& pair, const Eigen::MatrixX3d& w,
     if constexpr (kD) rec->set_pressed(l, pressed && has_normal);
 
     std::array<double, 2> t{0.0, 0.0};
-    if (!pressed || !(s.lim > 0.0))
-      separate<kD>(s, basis, rec, track);
-    else if (coupled && !exact)
-      t = coupled_radial_return<kD>(pair, s, basis, rec, track);
-    else if (coupled)
-      t = coupled_exact_linear<kD>(pair, s, basis, rec, track);
-    else
-      t = uncoupled<kD>(pair, s, rec);
+    if (!pressed || !(s.lim > 0.0)) separate<kD>(s, basis, rec, track);
+    else if (coupled && !exact) t = coupled_radial_return<kD>(pair, s, basis, rec, track);
+    else if (coupled) t = coupled_exact_linear<kD>(pair, s, basis, rec, track);
+    else t = uncoupled<kD>(pair, s, rec);
     f(l, 0) = t[0];
     f(l, 1) = t[1];
     f(l, 2) = has_normal ? nl : 0.0;
   }
 }
 
-template PeriodicStatus PeriodicLaw::run<true>(const PairParameters&, const Eigen::MatrixX3d&,
-                                               Eigen::MatrixX3d&, const Eigen::MatrixXd*,
-                                               LinearizedPeriod*);
-template PeriodicStatus PeriodicLaw::run<false>(const PairParameters&, const Eigen::MatrixX3d&,
-                                                Eigen::MatrixX3d&, const Eigen::MatrixXd*,
-                                                LinearizedPeriod*);
+template PeriodicStatus PeriodicLaw::run<true>(const PairParameters&, const Eigen::MatrixX3d&, Eigen::MatrixX3d&,
+                                               const Eigen::MatrixXd*, LinearizedPeriod*);
+template PeriodicStatus PeriodicLaw::run<false>(const PairParameters&, const Eigen::MatrixX3d&, Eigen::MatrixX3d&,
+                                                const Eigen::MatrixXd*, LinearizedPeriod*);
 
 }  // namespace shroudsim::contact

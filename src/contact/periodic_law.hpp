@@ -13,8 +13,9 @@
 //    safeguarded Newton iteration on g(d) = Phi(d) - d from there, with the 2x2 derivative
 //    Phi_d carried through each period (contraction where the pair slips, the identity in
 //    pure stick where every d is periodic and d = 0 is kept; exactly neutral directions are
-//    left alone): a Newton step is accepted when it reduces max|g|, else the plain
-//    repetition d <- Phi(d) is taken.
+//    left alone): a Newton step is accepted when it reduces max|g|, else it is halved (up
+//    to 4 times) and, if none of those reduces max|g| either, the plain repetition
+//    d <- Phi(d) is taken.
 // Both stop when |d_end - d_start| <= period_tolerance * max_l |w_t(l)| for the returned
 // period (the last one computed, started from the accepted iterate), capped by max_periods
 // periods; the status says whether it converged. Deterministic: same input, same iterates.
@@ -56,9 +57,8 @@ class PeriodicLaw {
   /// basis, lin: both null (forces only) or both set; then *lin holds the derivative of the
   /// returned period w.r.t. P = n_directions(model) * basis->cols() unknowns (see
   /// LinearizedPeriod), carried exactly through all repeated periods.
-  PeriodicStatus evaluate(const PairParameters& pair, const Eigen::MatrixX3d& w,
-                          Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis = nullptr,
-                          LinearizedPeriod* lin = nullptr);
+  PeriodicStatus evaluate(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
+                          const Eigen::MatrixXd* basis = nullptr, LinearizedPeriod* lin = nullptr);
 
   const LawOptions& options() const { return options_; }
 
@@ -75,8 +75,8 @@ class PeriodicLaw {
   /// also carry D_ = d(d)/d(d_start) (2 x 2, coupled model) and, with kWithDerivative, the
   /// sensitivities of the recorded rows to d_start (run_d_, dense_q_).
   template <bool kWithDerivative>
-  void period(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
-              const Eigen::MatrixXd* basis, LinearizedPeriod* lin, bool track);
+  void period(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f, const Eigen::MatrixXd* basis,
+              LinearizedPeriod* lin, bool track);
 
   /// What a sample's update needs of the motion and the normal load (defined in the .cpp).
   struct Sample;
@@ -84,11 +84,11 @@ class PeriodicLaw {
   // itself); each advances the period state and, with kWithDerivative, records into rec.
   // Returns (Tx, Ty).
   template <bool kWithDerivative>
-  std::array<double, 2> coupled_radial_return(const PairParameters& pair, const Sample& s,
-                                              const Eigen::MatrixXd* basis, PeriodRecorder* rec, bool track);
+  std::array<double, 2> coupled_radial_return(const PairParameters& pair, const Sample& s, const Eigen::MatrixXd* basis,
+                                              PeriodRecorder* rec, bool track);
   template <bool kWithDerivative>
-  std::array<double, 2> coupled_exact_linear(const PairParameters& pair, const Sample& s,
-                                             const Eigen::MatrixXd* basis, PeriodRecorder* rec, bool track);
+  std::array<double, 2> coupled_exact_linear(const PairParameters& pair, const Sample& s, const Eigen::MatrixXd* basis,
+                                             PeriodRecorder* rec, bool track);
   template <bool kWithDerivative>
   std::array<double, 2> uncoupled(const PairParameters& pair, const Sample& s, PeriodRecorder* rec);
   /// Separation (or no friction): T = 0, the damper follows the motion.

@@ -56,7 +56,8 @@ Eigen::Vector3d StaticContact::law(const StaticPairParameters& p, const Eigen::V
   const Eigen::Vector2d e = trial / norm;
   F.head<2>() = limit * e;
   if (dF) {
-    dF->topLeftCorner<2, 2>() = limit / norm * p.tangential_stiffness * (Eigen::Matrix2d::Identity() - e * e.transpose());
+    dF->topLeftCorner<2, 2>() =
+        limit / norm * p.tangential_stiffness * (Eigen::Matrix2d::Identity() - e * e.transpose());
     dF->block<2, 1>(0, 2) = p.friction_coefficient * p.normal_stiffness * e;
   }
   if (state) *state = StaticState::slip;

@@ -138,7 +138,8 @@ TEST(StaticContact, SlipJacobianMatchesFiniteDifferences) {
   for (int j = 0; j < 3; ++j) {
     Eigen::Vector3d gp = g, gm = g;
     gp[j] += h, gm[j] -= h;
-    const Eigen::Vector3d fd = (StaticContact::law(p, gp, s, nullptr, nullptr) - StaticContact::law(p, gm, s, nullptr, nullptr)) / (2 * h);
+    const Eigen::Vector3d fd =
+        (StaticContact::law(p, gp, s, nullptr, nullptr) - StaticContact::law(p, gm, s, nullptr, nullptr)) / (2 * h);
     EXPECT_LT((fd - dF.col(j)).norm(), 1e-5 * dF.norm()) << j;
   }
 }
