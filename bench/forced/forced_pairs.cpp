@@ -25,13 +25,13 @@
 #include <string>
 #include <vector>
 
-#include "app/context.hpp"
-#include "app/forced_stage.hpp"
 #include "continuation/arclength.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "forced/reduced_equations.hpp"
 #include "io/case.hpp"
+#include "pipeline/context.hpp"
+#include "pipeline/forced_model.hpp"
 
 using namespace shroudsim;
 
@@ -59,15 +59,15 @@ int main(int argc, char** argv) {
   }
   try {
     log::set_verbose(false);
-    app::Context ctx;
+    pipeline::Context ctx;
     ctx.config = io::load_case(case_file, sets);
     ctx.threads = threads;
     ctx.plots = false;
     ctx.out_dir = "/tmp";
     const io::Case& c = ctx.config;
-    app::ForcedModel model = c.structure.type == io::StructureType::lumped ? app::make_lumped_model(c)
-                                                                           : app::make_sector_model(ctx);
-    const hbm::ContactEvaluatorOptions eo = app::evaluator_options(c, threads);
+    pipeline::ForcedModel model = c.structure.type == io::StructureType::lumped ? pipeline::make_lumped_model(c)
+                                                                                : pipeline::make_sector_model(ctx);
+    const hbm::ContactEvaluatorOptions eo = pipeline::evaluator_options(c, threads);
     hbm::ContactEvaluator evaluator(eo, model.pairs);
     forced::ReducedEquations equations(*model.linear, evaluator);
     forced::LinearSolverOptions so;
@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
 
     // The units, options and start of the frequency response (forced/frequency_response.hpp).
     const continuation::ArclengthOptions ao =
-        forced::arclength_options(app::frequency_response_settings(c), model, equations);
+        forced::arclength_options(pipeline::frequency_response_settings(c), model, equations);
 
     log::Stopwatch clock;
     std::string how;

@@ -14,7 +14,6 @@
 #include <sstream>
 
 #include "app/context.hpp"
-#include "app/modal_stage.hpp"
 #include "campbell/campbell.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"

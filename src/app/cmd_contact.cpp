@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "app/context.hpp"
-#include "app/modal_stage.hpp"
 #include "contact/contact_law.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"

@@ -11,8 +11,6 @@
 #include <sstream>
 
 #include "app/context.hpp"
-#include "app/forced_stage.hpp"
-#include "app/modal_stage.hpp"
 #include "continuation/arclength.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -25,17 +23,6 @@
 
 namespace shroudsim::app {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-contact::PairParameters pair_of(const io::ContactSection& c, const io::ContactElement* e) {
-  contact::PairParameters p;
-  p.friction_coefficient = e && e->friction_coefficient ? *e->friction_coefficient : c.friction_coefficient;
-  p.normal_stiffness = e && e->normal_stiffness ? *e->normal_stiffness : c.normal_stiffness;
-  p.tangential_stiffness = e && e->tangential_stiffness ? *e->tangential_stiffness : c.tangential_stiffness;
-  p.normal_preload = e && e->normal_preload ? *e->normal_preload : c.normal_preload;
-  return p;
-}
 
 /// hbm.harmonics and/or hbm.time_samples = "auto": the search of
 /// forced/discretization_search.hpp, each trial a full `frf` run into <out>/auto/H=..__N=../
@@ -144,58 +131,6 @@ int frf_auto(Context& ctx) {
 }
 
 }  // namespace
-
-ForcedModel make_lumped_model(const io::Case& c) {
-  ForcedModel model;
-  std::vector<frf::LumpedContact> contacts;
-  for (const auto& e : c.contact.elements) {
-    frf::LumpedContact lc;
-    lc.dof = {e.x_dof, e.y_dof, e.z_dof};
-    lc.other = {e.other_x_dof, e.other_y_dof, e.other_z_dof};
-    lc.frame_angle = (e.frame_angle_deg ? *e.frame_angle_deg : c.contact.frame_angle_deg) * kDeg;
-    contacts.push_back(lc);
-    model.pairs.push_back(pair_of(c.contact, &e));
-  }
-  if (contacts.empty())
-    throw InputError(c.locations.at("contact.elements") +
-                     ": contact.elements: a lumped forced response needs at least one [[contact.elements]]");
-  model.linear = std::make_unique<frf::LumpedLinearPart>(c.structure.mass, c.structure.stiffness, c.structure.damping,
-                                                         contacts, c.excitation.dof, c.excitation.force[0],
-                                                         c.response.dof);
-  return model;
-}
-
-hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads) {
-  hbm::ContactEvaluatorOptions o;
-  o.n_harmonics = c.hbm.harmonics;
-  o.n_time_samples = c.hbm.time_samples;
-  o.law.model = c.contact.model;
-  o.law.update = c.contact.tangential_update;
-  o.jacobian = c.hbm.jacobian;
-  o.threads = threads;
-  // FFTW_MEASURE picks plans by timing, so round-off (and with it a Newton path through
-  // nonsmooth contact states) would change from run to run: estimated plans are reproducible.
-  o.measure_plans = false;
-  if (o.law.model == contact::Model::one_d_exact && o.n_harmonics != 1)
-    throw InputError(
-        c.locations.at("hbm.harmonics") + ": hbm.harmonics = " + std::to_string(c.hbm.harmonics) +
-        " violates: harmonics = 1 for contact.model = \"1d_exact\" (the time-continuous single-harmonic law)");
-  std::vector<std::string> errors;
-  if (!o.validate(&errors)) {
-    throw InputError(c.where("hbm.time_samples") + ": hbm: " + errors.front());
-  }
-  return o;
-}
-
-forced::FrequencyResponseSettings frequency_response_settings(const io::Case& c) {
-  forced::FrequencyResponseSettings s;
-  s.frequency_start_hz = c.continuation.frequency_start_hz;
-  s.frequency_end_hz = c.continuation.frequency_end_hz;
-  s.initial_step_hz = c.continuation.initial_step;
-  s.max_points = c.continuation.max_points;
-  s.tolerance = c.hbm.tolerance;
-  return s;
-}
 
 int cmd_frf(Context& ctx) {
   const io::Case& c = ctx.config;

@@ -8,7 +8,6 @@
 #include <sstream>
 
 #include "app/context.hpp"
-#include "app/modal_stage.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "fe/rotating.hpp"
@@ -18,18 +17,6 @@
 #include "modal/rotating.hpp"
 
 namespace shroudsim::app {
-
-frf::StaticShroudSettings static_shroud_settings(const io::Case& c, double speed_rpm) {
-  frf::StaticShroudSettings s;
-  s.speed_rad_s = modal::rpm_to_rad_s(speed_rpm);
-  s.increments = c.static_contact.increments;
-  s.interference = c.contact.interference;
-  s.normal_stiffness = c.contact.normal_stiffness;
-  s.tangential_stiffness = c.contact.tangential_stiffness;
-  s.friction_coefficient = c.contact.friction_coefficient;
-  s.frame_angle = c.contact.frame_angle_deg * std::numbers::pi / 180.0;
-  return s;
-}
 
 int cmd_static(Context& ctx) {
   const io::Case& c = ctx.config;

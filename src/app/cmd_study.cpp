@@ -18,7 +18,6 @@
 #include <thread>
 
 #include "app/context.hpp"
-#include "app/modal_stage.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"

@@ -1,44 +1,14 @@
 #pragma once
-// What every subcommand receives and fills: the parsed case, the result folder, and the
-// run report that becomes run.json. Stage drivers (cmd_*.cpp) map io::Case onto the
-// stages' own *Options, run them, write their result files atomically (io/output.hpp),
-// print one progress line per stage (log::info), and record timings in the report.
-#include <filesystem>
-#include <nlohmann/json.hpp>
-#include <string>
-
-#include "io/case.hpp"
-#include "mesh/mesh.hpp"
+// The subcommands: each maps the case onto pipeline stages and library calls and writes its
+// result files. They are written against the pipeline library (src/pipeline), whose names
+// they use unqualified.
+#include "pipeline/context.hpp"
+#include "pipeline/forced_model.hpp"
+#include "pipeline/modal_stage.hpp"
 
 namespace shroudsim::app {
 
-/// Collects what run.json reports: stage timings, what was reused, statistics, warnings.
-class RunReport {
- public:
-  /// One finished stage: name, wall time in seconds, whether it came from the cache.
-  void stage(const std::string& name, double seconds, bool reused = false);
-  /// A warning: printed to stderr now (never silenced) and listed in run.json.
-  void warn(const std::string& message);
-  /// Free-form statistics under a top-level key (e.g. "mesh", "modal", "newton").
-  nlohmann::json& section(const std::string& key) { return json_[key]; }
-  const nlohmann::json& json() const { return json_; }
-  double total_seconds() const;
-
- private:
-  nlohmann::json json_ = nlohmann::json::object();
-};
-
-struct Context {
-  io::Case config;                     ///< the case as run (after --set)
-  std::filesystem::path out_dir;       ///< result folder (created on demand)
-  int threads = 0;                     ///< 0: all cores
-  std::vector<std::string> overrides;  ///< the command line's --set KEY=VALUE, in order
-  bool plots = true;                   ///< draw plots after a command (off for study points)
-  bool convergence = false;            ///< `study --convergence`: the accuracy/speed trade
-  /// (frequency [Hz], amplitude [m]) of the forced response cmd_frf traced (as in frf.csv).
-  std::vector<std::pair<double, double>> frf_curve;
-  RunReport report;
-};
+using namespace shroudsim::pipeline;  // NOLINT(google-build-using-namespace): the commands' vocabulary
 
 /// Subcommands. Each returns the process exit status (0, 2, 3) or throws
 /// InputError (-> 2) / NumericalError (-> 3).
@@ -52,9 +22,8 @@ int cmd_study(Context& ctx);
 /// Every stage the case asks for, in order.
 int cmd_run(Context& ctx);
 
-/// The sector mesh of the case: [structure] mesh read and checked, or generated from
-/// [geometry] into meshes/<name>.msh (reused when the cached mesh matches the geometry).
-/// Throws InputError for a bad mesh. Records the "mesh" stage in the report.
-mesh::Mesh obtain_mesh(Context& ctx);
+/// Runs tools/plot.py on the result folder when /usr/bin/python3 has matplotlib; otherwise
+/// says that plots are skipped. A plotting failure is a warning, not an error.
+void draw_plots(Context& ctx);
 
 }  // namespace shroudsim::app

@@ -2,8 +2,8 @@
 // (mesh, K and M, modes): sector cases mesh -> modes -> campbell -> static (when the case
 // gives a static speed or an interference) -> frf; lumped cases frf.
 #include "app/context.hpp"
-#include "app/forced_stage.hpp"
 #include "core/log.hpp"
+#include "pipeline/forced_model.hpp"
 
 namespace shroudsim::app {
 

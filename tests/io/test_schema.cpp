@@ -202,7 +202,7 @@ TEST(Schema, LibraryDefaultsAgreeWithTheCaseDefaults) {
   EXPECT_EQ(arclength.tolerance, c.hbm.tolerance);
 
   // frf::StaticShroudSettings: its stiffnesses and friction coefficient default to 0 (not
-  // usable: the caller always sets them, app/cmd_static.cpp from contact.*); the rest agree.
+  // usable: the caller always sets them, pipeline/modal_stage.cpp from contact.*); the rest agree.
   const frf::StaticShroudSettings settings;
   EXPECT_EQ(settings.increments, c.static_contact.increments);
   EXPECT_EQ(settings.interference, c.contact.interference);

@@ -19,14 +19,14 @@
 #include <string>
 #include <vector>
 
-#include "app/context.hpp"
 #include "cyclic/cyclic_sector.hpp"
 #include "fe/tet_element.hpp"
 #include "frf/static_shroud.hpp"
 #include "linalg/sparse.hpp"
 #include "modal/eigensolver.hpp"
+#include "pipeline/context.hpp"
 
-namespace shroudsim::app {
+namespace shroudsim::pipeline {
 
 struct ModalModel {
   mesh::Mesh mesh;
@@ -89,8 +89,5 @@ void write_modes_csv(Context& ctx, const ModalModel& model);
 /// the real part of the mode shape on every node (cyclic_high included) after turning its
 /// phase so that the largest component is real.
 void write_modes_vtu(Context& ctx, ModalModel& model);
-/// Runs tools/plot.py on the result folder when /usr/bin/python3 has matplotlib; otherwise
-/// says that plots are skipped. A plotting failure is a warning, not an error.
-void draw_plots(Context& ctx);
 
-}  // namespace shroudsim::app
+}  // namespace shroudsim::pipeline

@@ -1,8 +1,8 @@
-#include "app/context.hpp"
+#include "pipeline/context.hpp"
 
 #include "core/log.hpp"
 
-namespace shroudsim::app {
+namespace shroudsim::pipeline {
 
 void RunReport::stage(const std::string& name, double seconds, bool reused) {
   json_["stages"].push_back({{"name", name}, {"seconds", seconds}, {"reused", reused}});
@@ -20,4 +20,4 @@ double RunReport::total_seconds() const {
   return total;
 }
 
-}  // namespace shroudsim::app
+}  // namespace shroudsim::pipeline

@@ -5,15 +5,15 @@
 #include <mutex>
 #include <sstream>
 
-#include "app/context.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/output.hpp"
 #include "mesh/checks.hpp"
 #include "mesh/msh_reader.hpp"
 #include "mesh/sector_generator.hpp"
+#include "pipeline/context.hpp"
 
-namespace shroudsim::app {
+namespace shroudsim::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
@@ -125,4 +125,4 @@ mesh::Mesh obtain_mesh(Context& ctx) {
   return m;
 }
 
-}  // namespace shroudsim::app
+}  // namespace shroudsim::pipeline

@@ -1,18 +1,19 @@
 #pragma once
-// The forced-response models the frf command builds from a case.
+// The forced-response model of a case (lumped or FE sector), its contact evaluator options and
+// continuation settings: what `frf`, `study` and the benchmarks build a forced response from.
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "app/context.hpp"
 #include "contact/contact_law.hpp"
 #include "continuation/arclength.hpp"
 #include "forced/frequency_response.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/linear_part.hpp"
 #include "hbm/contact_evaluator.hpp"
+#include "pipeline/context.hpp"
 
-namespace shroudsim::app {
+namespace shroudsim::pipeline {
 
 using forced::ForcedModel;
 
@@ -29,4 +30,4 @@ hbm::ContactEvaluatorOptions evaluator_options(const io::Case& c, int threads);
 /// The [continuation] settings of a case's forced response (forced/frequency_response.hpp).
 forced::FrequencyResponseSettings frequency_response_settings(const io::Case& c);
 
-}  // namespace shroudsim::app
+}  // namespace shroudsim::pipeline
