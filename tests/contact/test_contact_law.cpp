@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "contact/friction_step.hpp"
 #include "contact/periodic_law.hpp"
@@ -314,6 +316,50 @@ Eigen::MatrixX3d motion(const Eigen::MatrixXd& basis, const double (&state)[3][k
   for (int j = 0; j < 3; ++j) w.col(j) = basis * Eigen::Map<const Eigen::VectorXd>(state[j], kM);
   return w;
 }
+
+// The analytical derivative `df` of the converged periodic map against central differences
+// (step `step` in every harmonic column of x, y, z): the worst column error relative to the
+// largest column, and that largest column norm. Every perturbed evaluation must converge.
+struct ColumnErrors {
+  double worst = 0.0;  ///< max over columns of |df_c - fd_c| / scale
+  double scale = 0.0;  ///< the largest column norm of the central differences
+};
+inline ColumnErrors central_difference_columns(shroudsim::contact::PeriodicLaw& law,
+                                               const shroudsim::contact::PairParameters& p, const Eigen::MatrixX3d& w0,
+                                               const Eigen::MatrixXd& basis,
+                                               const std::array<shroudsim::contact::RowMatrix, 3>& df, double step) {
+  const int m = static_cast<int>(basis.cols());
+  std::vector<double> err(3 * m), ref(3 * m);
+  for (int c = 0; c < 3 * m; ++c) {
+    Eigen::MatrixX3d wp = w0, wm = w0, fp, fm;
+    wp.col(c / m) += step * basis.col(c % m);
+    wm.col(c / m) -= step * basis.col(c % m);
+    EXPECT_TRUE(law.evaluate(p, wp, fp).converged) << "column " << c;
+    EXPECT_TRUE(law.evaluate(p, wm, fm).converged) << "column " << c;
+    const Eigen::MatrixX3d fd = (fp - fm) / (2.0 * step);
+    for (int i = 0; i < 3; ++i) {
+      err[c] += (df[i].col(c) - fd.col(i)).squaredNorm();
+      ref[c] += fd.col(i).squaredNorm();
+    }
+  }
+  ColumnErrors out;
+  out.scale = std::sqrt(*std::max_element(ref.begin(), ref.end()));
+  for (int c = 0; c < 3 * m; ++c) out.worst = std::max(out.worst, std::sqrt(err[c]) / out.scale);
+  return out;
+}
+
+// Translation invariance of the periodic limit: a uniform tangential shift moves the slider
+// along and leaves the forces unchanged, so d(T)/d(mean x) and d(T)/d(mean y) vanish. Returns
+// the larger of the two column norms relative to `scale`.
+inline double mean_tangential_columns(const std::array<shroudsim::contact::RowMatrix, 3>& df, int m, double scale) {
+  double worst = 0.0;
+  for (int c : {0, m}) {
+    double col = 0.0;
+    for (int i = 0; i < 2; ++i) col += df[i].col(c).squaredNorm();
+    worst = std::max(worst, std::sqrt(col) / scale);
+  }
+  return worst;
+}
 }  // namespace shroudsim_periodic_test
 
 // The coupled law's steady state by Newton on the period map: a state that plain repetition
@@ -358,30 +404,11 @@ TEST(PeriodicLaw, SlowlyContractingStateConvergesInFewPeriodsWithExactDerivative
     // repetition did not reproduce.
     constexpr double kStep = 1e-14;  // m
     constexpr double kTol = 1e-4;    // relative to the largest column (a dropped dd*/dc term is O(1))
-    std::vector<double> err(3 * kM), ref(3 * kM);
-    for (int c = 0; c < 3 * kM; ++c) {
-      Eigen::MatrixX3d wp = w0, wm = w0, fp, fm;
-      wp.col(c / kM) += kStep * basis.col(c % kM);
-      wm.col(c / kM) -= kStep * basis.col(c % kM);
-      law.evaluate(p, wp, fp);
-      law.evaluate(p, wm, fm);
-      const Eigen::MatrixX3d fd = (fp - fm) / (2.0 * kStep);
-      for (int i = 0; i < 3; ++i) {
-        err[c] += (df[i].col(c) - fd.col(i)).squaredNorm();
-        ref[c] += fd.col(i).squaredNorm();
-      }
-    }
-    const double scale = std::sqrt(*std::max_element(ref.begin(), ref.end()));
-    double worst = 0.0;
-    for (int c = 0; c < 3 * kM; ++c) worst = std::max(worst, std::sqrt(err[c]) / scale);
-    EXPECT_LE(worst, kTol);
+    const auto fd = shroudsim_periodic_test::central_difference_columns(law, p, w0, basis, df, kStep);
+    EXPECT_LE(fd.worst, kTol);
     // Translation invariance of the periodic limit: d(T)/d(mean x), d(T)/d(mean y) vanish.
     constexpr double kInvariant = 1e-6;  // relative; round-off of the 2 x 2 solve and the sums
-    for (int c : {0, kM}) {
-      double col = 0.0;
-      for (int i = 0; i < 2; ++i) col += df[i].col(c).squaredNorm();
-      EXPECT_LE(std::sqrt(col) / scale, kInvariant) << "column " << c;
-    }
+    EXPECT_LE(shroudsim_periodic_test::mean_tangential_columns(df, kM, fd.scale), kInvariant);
   }
 }
 
@@ -430,29 +457,9 @@ TEST(PeriodicLaw, BentSlowDirectionConvergesWithDampedNewtonAndExactDerivative) 
     // off by O(1).
     constexpr double kStep = 1e-12;  // m, against displacements of 5e-5 m
     constexpr double kTol = 2e-4;    // relative to the largest column
-    std::vector<double> err(3 * kM), ref(3 * kM);
-    for (int c = 0; c < 3 * kM; ++c) {
-      Eigen::MatrixX3d wp = w0, wm = w0, fp, fm;
-      wp.col(c / kM) += kStep * basis.col(c % kM);
-      wm.col(c / kM) -= kStep * basis.col(c % kM);
-      EXPECT_TRUE(law.evaluate(p, wp, fp).converged);
-      EXPECT_TRUE(law.evaluate(p, wm, fm).converged);
-      const Eigen::MatrixX3d fd = (fp - fm) / (2.0 * kStep);
-      for (int i = 0; i < 3; ++i) {
-        err[c] += (df[i].col(c) - fd.col(i)).squaredNorm();
-        ref[c] += fd.col(i).squaredNorm();
-      }
-    }
-    const double scale = std::sqrt(*std::max_element(ref.begin(), ref.end()));
-    double worst = 0.0;
-    for (int c = 0; c < 3 * kM; ++c) worst = std::max(worst, std::sqrt(err[c]) / scale);
-    EXPECT_LE(worst, kTol);
-    // Translation invariance of the periodic limit (as above).
-    constexpr double kInvariant = 1e-6;
-    for (int c : {0, kM}) {
-      double col = 0.0;
-      for (int i = 0; i < 2; ++i) col += df[i].col(c).squaredNorm();
-      EXPECT_LE(std::sqrt(col) / scale, kInvariant) << "column " << c;
-    }
+    const auto fd = shroudsim_periodic_test::central_difference_columns(law, p, w0, basis, df, kStep);
+    EXPECT_LE(fd.worst, kTol);
+    constexpr double kInvariant = 1e-6;  // as above
+    EXPECT_LE(shroudsim_periodic_test::mean_tangential_columns(df, kM, fd.scale), kInvariant);
   }
 }
