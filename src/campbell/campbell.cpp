@@ -2,7 +2,6 @@
 #include "core/format.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <sstream>
 #include <tuple>
@@ -13,16 +12,7 @@
 #include "modal/rotating.hpp"
 
 namespace shroudsim::campbell {
-namespace {
-
-// Shortest round-trip text of a speed (as the result files write numbers).
-std::string number(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 std::vector<double> speed_points(double s0, double s1, int n) {
   std::vector<double> rpm(n);
@@ -68,7 +58,7 @@ HarmonicSweep sweep_harmonic(const cyclic::CyclicSector& sector, const cyclic::C
       }
       if (states && i >= states->solved()) {
         s.failure =
-            "harmonic index " + std::to_string(h) + ": no static shroud contact state at " + number(rpm[i]) + " rpm";
+            "harmonic index " + std::to_string(h) + ": no static shroud contact state at " + shortest(rpm[i]) + " rpm";
         break;
       }
       log::Stopwatch solve_clock;
@@ -79,7 +69,7 @@ HarmonicSweep sweep_harmonic(const cyclic::CyclicSector& sector, const cyclic::C
       s.lanczos_seconds += r.report.solve_seconds;
       ++s.solves;
       if (!r.report.ok()) {
-        s.failure = "harmonic index " + std::to_string(h) + " at " + number(rpm[i]) +
+        s.failure = "harmonic index " + std::to_string(h) + " at " + shortest(rpm[i]) +
                     " rpm: " + modal::to_string(r.report.status) + ": " + r.report.message +
                     (r.report.status == modal::ModalStatus::FactorizationFailed
                          ? " (K + K_sigma - Omega^2 M_spin is not positive definite: a mode diverges)"
@@ -88,8 +78,8 @@ HarmonicSweep sweep_harmonic(const cyclic::CyclicSector& sector, const cyclic::C
         // linearly in Omega^2 from the last two speeds, when that lands in between.
         if (i >= 1 && s.f[i - 1].size() > 0) {
           const double fb = s.f[i - 1](0);
-          s.failure += "; the lowest mode is " + fixed(fb, 1) + " Hz at " + number(rpm[i - 1]) +
-                       " rpm and diverges below " + number(rpm[i]) + " rpm";
+          s.failure += "; the lowest mode is " + fixed(fb, 1) + " Hz at " + shortest(rpm[i - 1]) +
+                       " rpm and diverges below " + shortest(rpm[i]) + " rpm";
           if (i >= 2 && s.f[i - 2].size() > 0 && fb < s.f[i - 2](0)) {
             const double fa = s.f[i - 2](0);
             const double wa = rpm[i - 2] * rpm[i - 2], wb = rpm[i - 1] * rpm[i - 1];

@@ -1,23 +1,17 @@
 #include "forced/frequency_response.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
 #include "continuation/events.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "forced/excitation_homotopy.hpp"
 
 namespace shroudsim::forced {
 namespace {
-
-std::string number(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
 
 using Info = std::function<void(const std::string&)>;
 
@@ -46,7 +40,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
     // Equations that cannot be evaluated here have no solution to find: say why.
     Eigen::VectorXd r;
     if (!start.allFinite() || !equations.evaluate(start, f, r, nullptr, nullptr) || !r.allFinite())
-      throw NumericalError("the harmonic-balance equations are not finite at " + number(f) +
+      throw NumericalError("the harmonic-balance equations are not finite at " + shortest(f) +
                            " Hz: a harmonic of this frequency lies on a natural frequency without damping (the "
                            "receptance is infinite there); give the structure damping or start the range elsewhere");
   }
@@ -57,7 +51,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   if (eo.n_harmonics > 1) {
     // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
     // each new harmonic starting at zero (higher harmonics are small corrections).
-    say(info, "frf: start point at " + number(f) + " Hz by harmonic stepping (H = 1 .. " +
+    say(info, "frf: start point at " + shortest(f) + " Hz by harmonic stepping (H = 1 .. " +
                   std::to_string(eo.n_harmonics) + ")");
     Eigen::VectorXd prev;
     int prev_h = 0;
@@ -102,7 +96,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   const continuation::Branch h = solve_by_excitation_homotopy(equations, f, ao, start);
   if (h.status != continuation::BranchStatus::kReachedEnd)
     throw NumericalError(
-        "no solution at the start frequency " + number(f) +
+        "no solution at the start frequency " + shortest(f) +
         " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
         h.message);
   say(info, "frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) +
@@ -133,8 +127,8 @@ Eigen::VectorXd find_start_logged(const ForcedModel& model, const hbm::ContactEv
       for (int k = 1; k <= kWalkSteps && ok; ++k)
         ok = continuation::newton_fixed(equations, x, g + (f - g) * k / kWalkSteps, ao) >= 0;
       if (!ok) continue;
-      how = how_g + " at " + number(g) + " Hz, then Newton to " + number(f) + " Hz";
-      say(info, "frf: start point at " + number(f) + " Hz from " + how);
+      how = how_g + " at " + shortest(g) + " Hz, then Newton to " + shortest(f) + " Hz";
+      say(info, "frf: start point at " + shortest(f) + " Hz from " + how);
       return x;
     }
     throw;
@@ -249,8 +243,9 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
       first.status != continuation::BranchStatus::kStartFailed &&
       first.status != continuation::BranchStatus::kMaxPoints) {
     const std::string first_message = first.message;
-    say(info, "frf: the branch from " + number(ao.lambda_start) + " Hz stopped (" + first.message +
-                  ") having reached " + number(reached) + " Hz; tracing back from " + number(ao.lambda_end) + " Hz");
+    say(info, "frf: the branch from " + shortest(ao.lambda_start) + " Hz stopped (" + first.message +
+                  ") having reached " + shortest(reached) + " Hz; tracing back from " + shortest(ao.lambda_end) +
+                  " Hz");
     continuation::ArclengthOptions back = ao;
     back.lambda_start = ao.lambda_end;
     const double overlap = 4.0 * ao.initial_step * ao.lambda_scale;
@@ -278,32 +273,32 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
         // Both pieces turned back, but between them every frequency of the range has a
         // solution: reported as two separate branches.
         out.pieces_join = false;
-        covered_with("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
-                     " Hz turned back at " + number(reached) + " Hz (" + first_message +
-                     "), the branch traced back from " + number(ao.lambda_end) + " Hz turned back at " +
-                     number(reached_back) +
+        covered_with("the curve is two separate branches: the branch from " + shortest(ao.lambda_start) +
+                     " Hz turned back at " + shortest(reached) + " Hz (" + first_message +
+                     "), the branch traced back from " + shortest(ao.lambda_end) + " Hz turned back at " +
+                     shortest(reached_back) +
                      " Hz; together they cover the range, but they were not shown to be one branch "
                      "(frf.csv column `piece`)");
       } else if (second.status != continuation::BranchStatus::kReachedEnd) {
         out.pieces_join = false;
         out.summary.message =
-            first_message + "; tracing back from " + number(ao.lambda_end) + " Hz stopped too: " + second.message;
+            first_message + "; tracing back from " + shortest(ao.lambda_end) + " Hz stopped too: " + second.message;
       } else {
         out.join_distance = continuation::distance_to_branch(equations, ao, first.points, second.points.back());
         // Two solutions of the same equations to tolerance agree far within a step.
         out.pieces_join = out.join_distance <= kJoinTolerance;
         if (out.pieces_join) {
-          covered_with("the curve is in two pieces: the branch from " + number(ao.lambda_start) + " Hz stopped at " +
-                       number(reached) + " Hz (" + first_message + "); the rest was traced back from " +
-                       number(ao.lambda_end) + " Hz and joins it (frf.csv column `piece`)");
+          covered_with("the curve is in two pieces: the branch from " + shortest(ao.lambda_start) + " Hz stopped at " +
+                       shortest(reached) + " Hz (" + first_message + "); the rest was traced back from " +
+                       shortest(ao.lambda_end) + " Hz and joins it (frf.csv column `piece`)");
         } else {
           // Both pieces are solutions to tolerance and together they cover the range, but
           // they were not shown to be one branch (typically the two stable sides of a fold
           // pair, the unstable branch between them left untraced): reported as two branches.
-          covered_with("the curve is two separate branches: the branch from " + number(ao.lambda_start) +
-                       " Hz stopped at " + number(reached) + " Hz (" + first_message +
-                       "); the branch traced back from " + number(ao.lambda_end) +
-                       " Hz covers the rest but does not join it (scaled distance " + number(out.join_distance) +
+          covered_with("the curve is two separate branches: the branch from " + shortest(ao.lambda_start) +
+                       " Hz stopped at " + shortest(reached) + " Hz (" + first_message +
+                       "); the branch traced back from " + shortest(ao.lambda_end) +
+                       " Hz covers the rest but does not join it (scaled distance " + shortest(out.join_distance) +
                        "; frf.csv column `piece`)");
         }
       }

@@ -1,11 +1,11 @@
 #include "io/output.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <random>
 
 #include "core/error.hpp"
+#include "core/format.hpp"
 
 namespace shroudsim::io {
 
@@ -29,9 +29,7 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
 
 std::string format_number(double value) {
   if (!std::isfinite(value)) throw NumericalError("a non-finite value (NaN or Inf) would reach a result file");
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, value);
-  return std::string(buf, res.ptr);
+  return shortest(value);
 }
 
 }  // namespace shroudsim::io

@@ -174,9 +174,7 @@ Vary read_vary(const Reader& r, const std::string& key, const Case&) {
       std::ostringstream s;
       if (auto str = e.as_string()) s << '"' << str->get() << '"';
       else if (auto fl = e.as_floating_point()) {
-        char buf[32];  // shortest text that reads back to the same double
-        const auto res = std::to_chars(buf, buf + sizeof buf, fl->get());
-        std::string t(buf, res.ptr);
+        std::string t = shortest(fl->get());
         if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
         s << t;
       } else

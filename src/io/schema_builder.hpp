@@ -8,7 +8,6 @@
 // ("<key> = <value> violates: <text>") and what the docs list. Bounds generate their text
 // ("> 0", "-1 < poisson_ratio < 0.5", "1 <= value <= 200"), comparisons with another key
 // theirs ("disk_outer_radius > hub_radius"); other rules give it.
-#include <charconv>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -16,6 +15,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/format.hpp"
 #include "io/case.hpp"
 #include "io/case_reader.hpp"
 #include "io/schema.hpp"
@@ -24,9 +24,7 @@ namespace shroudsim::io::schema {
 
 /// Shortest text that reads back to v ("0.5", "-1", "1e-8", "2.1e11").
 inline std::string number_text(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  std::string t(buf, res.ptr);
+  std::string t = shortest(v);
   const auto e = t.find('e');
   if (e != std::string::npos) {  // "1e-08" -> "1e-8", "2.1e+11" -> "2.1e11"
     std::string exp = t.substr(e + 1);
