@@ -1,0 +1,341 @@
+// The forced-response stage: see forced_response.hpp.
+#include "pipeline/forced_response.hpp"
+
+#include <filesystem>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
+
+#include "continuation/arclength.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "forced/discretization_search.hpp"
+#include "forced/reduced_equations.hpp"
+#include "hbm/contact_evaluator.hpp"
+#include "io/output.hpp"
+#include "pipeline/forced_model.hpp"
+#include "study/curves.hpp"
+
+namespace shroudsim::pipeline {
+namespace {
+
+/// The point the run reports as its peak: the largest located resonance peak, or the largest
+/// sampled point when none was located.
+struct ReportedPeak {
+  double amplitude_m = 0.0, frequency_hz = 0.0;
+  std::size_t point = 0;  ///< the point whose state gives the loops
+};
+
+ReportedPeak reported_peak(const forced::FrequencyResponse& response) {
+  ReportedPeak peak;
+  const auto& results = response.results;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (results[i].amplitude > results[peak.point].amplitude) peak.point = i;
+  if (!results.empty())
+    peak.amplitude_m = results[peak.point].amplitude, peak.frequency_hz = results[peak.point].frequency_hz;
+  for (const auto& pk : response.peaks)
+    if (pk.amplitude_m >= peak.amplitude_m) peak = {pk.amplitude_m, pk.frequency_hz, pk.point};
+  return peak;
+}
+
+/// frf.csv: every point with its harmonic amplitudes and piece.
+void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyResponse& response, int harmonics) {
+  std::ostringstream csv;
+  csv << "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations";
+  for (int n = 0; n <= harmonics; ++n) csv << ",h" << n << "_m";
+  csv << ",piece\n";
+  for (std::size_t i = 0; i < response.results.size(); ++i) {
+    const auto& r = response.results[i];
+    csv << io::format_number(r.frequency_hz) << "," << io::format_number(r.amplitude) << ","
+        << io::format_number(r.linear_amplitude) << "," << response.points[i].newton_iterations;
+    for (double a : r.harmonic_amplitudes) csv << "," << io::format_number(a);
+    csv << "," << response.piece[i] << "\n";
+  }
+  io::write_file_atomic(file, csv.str());
+}
+
+/// loops.csv: the hysteresis loops (relative displacement, contact force over one period) of
+/// the first 10 pairs at the state `w`.
+void write_loops_csv(const std::filesystem::path& file, hbm::ContactEvaluator& evaluator, const Eigen::VectorXd& w) {
+  std::ostringstream loops;
+  loops << "pair,sample,x_m,y_m,z_m,tx_n,ty_n,n_n\n";
+  const int block = evaluator.pair_layout().size();
+  for (int p = 0; p < std::min(evaluator.n_pairs(), 10); ++p) {
+    hbm::PairDetail d;
+    evaluator.evaluate_pair(p, w.segment(p * block, block), d, false);
+    for (Eigen::Index l = 0; l < d.w.rows(); ++l) {
+      loops << p << "," << l;
+      for (int k = 0; k < 3; ++k) loops << "," << io::format_number(d.w(l, k));
+      for (int k = 0; k < 3; ++k) loops << "," << io::format_number(d.f(l, k));
+      loops << "\n";
+    }
+  }
+  io::write_file_atomic(file, loops.str());
+}
+
+/// peaks.csv: the located resonance peaks (the plot reads this file).
+void write_peaks_csv(const std::filesystem::path& file, const forced::FrequencyResponse& response) {
+  std::ostringstream pk;
+  pk << "frequency_hz,amplitude_m,located,piece\n";
+  for (const auto& p : response.peaks)
+    pk << io::format_number(p.frequency_hz) << "," << io::format_number(p.amplitude_m) << "," << (p.located ? 1 : 0)
+       << "," << p.piece << "\n";
+  io::write_file_atomic(file, pk.str());
+}
+
+/// The branch's statistics, peaks and the solver's time in run.json "frf".
+void report_branch(nlohmann::json& j, const forced::FrequencyResponse& response,
+                   const forced::ReducedEquations& equations, int n_pairs) {
+  const continuation::Branch& branch = response.summary;
+  const continuation::ArclengthOptions& ao = response.options;
+  j["points"] = response.results.size();
+  j["pieces"] = response.piece.empty() ? 0 : response.piece.back() + 1;
+  j["status"] = continuation::to_string(branch.status);
+  j["message"] = branch.message;
+  j["turning_points"] = branch.turning_points;
+  j["newton_iterations"] = branch.newton_iterations;
+  j["rejected_steps"] = branch.rejected_steps;
+  j["rejected_turns"] = branch.rejected_turns;
+  j["kinks_crossed"] = branch.kinks_crossed;
+  j["reflections_crossed"] = branch.reflections_crossed;
+  j["residual_evaluations"] = branch.residual_evaluations;
+  j["unknowns"] = equations.size();
+  j["contact_pairs"] = n_pairs;
+  j["x_scale_m"] = ao.x_scale.size() ? ao.x_scale[0] : 1.0;
+  j["frequency_unit_hz"] = ao.lambda_scale;
+  j["initial_step_units"] = ao.initial_step;
+  j["smooth_folds"] = branch.smooth_folds;
+  if (response.two_pieces) {
+    j["pieces_join"] = response.pieces_join;
+    j["join_distance"] = response.join_distance;
+  }
+  j["peaks"] = nlohmann::json::array();
+  for (const auto& pk : response.peaks)
+    j["peaks"].push_back({{"frequency_hz", pk.frequency_hz},
+                          {"amplitude_m", pk.amplitude_m},
+                          {"located", pk.located},
+                          {"piece", pk.piece}});
+  j["peak_location_seconds"] = response.peak_seconds;
+  // Where the forced response's time went (all pieces; start searches with other H excluded).
+  const forced::SolverStatistics& st = equations.statistics();
+  j["solver"] = {{"evaluations", st.evaluations},
+                 {"jacobian_evaluations", st.jacobian_evaluations},
+                 {"repeated_evaluations", st.repeated_evaluations},
+                 {"dense_factorizations", st.dense_factorizations},
+                 {"krylov_solves", st.krylov_solves},
+                 {"krylov_iterations", st.krylov_iterations},
+                 {"krylov_failures", st.krylov_failures},
+                 {"double_solves", st.double_solves},
+                 {"contact_seconds", st.contact_seconds},
+                 {"receptance_seconds", st.receptance_seconds},
+                 {"jacobian_seconds", st.jacobian_seconds},
+                 {"solve_seconds", st.solve_seconds}};
+}
+
+/// One forced response at the case's fixed H and N.
+ForcedResponseOutcome trace_case(Context& ctx) {
+  const io::Case& c = ctx.config;
+  log::Stopwatch clock;
+  ForcedModel model = c.structure.type == io::StructureType::lumped ? make_lumped_model(c) : make_sector_model(ctx);
+  for (const auto& p : model.pairs) {
+    std::vector<std::string> errors;
+    if (!p.validate(c.contact.model, &errors)) {
+      throw InputError(c.where("contact.model") + ": [contact]: " + errors.front());
+    }
+  }
+  const hbm::ContactEvaluatorOptions eo = evaluator_options(c, ctx.threads);
+  hbm::ContactEvaluator evaluator(eo, model.pairs);
+  forced::ReducedEquations equations(*model.linear, evaluator);
+
+  log::info("frf: " + model.linear->describe() + ", " + std::to_string(evaluator.n_pairs()) + " contact pairs, " +
+            std::to_string(equations.size()) + " unknowns (H = " + std::to_string(c.hbm.harmonics) +
+            ", N = " + std::to_string(c.hbm.time_samples) + ", " + contact::to_string(c.contact.model) + ", " +
+            hbm::to_string(c.hbm.jacobian) + " Jacobian)");
+  int reported = 0;
+  auto progress = [&](const continuation::BranchPoint& p, int piece) {
+    ++reported;
+    if (log::verbose()) {
+      std::ostringstream s;
+      s << "frf: point " << reported << (piece ? " (piece 2)" : "") << "  f = " << std::setprecision(7) << p.lambda
+        << " Hz  step " << std::setprecision(3) << p.step << "  newton " << p.newton_iterations;
+      log::info(s.str());
+    }
+  };
+  const forced::FrequencyResponse response = forced::trace_frequency_response(
+      frequency_response_settings(c), model, eo, equations, progress, [](const std::string& s) { log::info(s); });
+  const continuation::Branch& branch = response.summary;
+  const std::vector<forced::PointResult>& results = response.results;
+  auto& j = ctx.report.section("frf");
+  j["start"] = response.start;
+  if (response.two_pieces) j["start_second_piece"] = response.start_second_piece;
+  for (const auto& w : response.warnings) ctx.report.warn(w);
+
+  const ReportedPeak peak = reported_peak(response);
+  write_frf_csv(ctx.out_dir / "frf.csv", response, c.hbm.harmonics);
+  ctx.frf_curve.clear();
+  for (const auto& r : results) ctx.frf_curve.emplace_back(r.frequency_hz, r.amplitude);
+  if (!response.points.empty()) write_loops_csv(ctx.out_dir / "loops.csv", evaluator, response.points[peak.point].x);
+  write_peaks_csv(ctx.out_dir / "peaks.csv", response);
+
+  double max_energy_error = 0.0, worst_energy_f = 0.0;
+  int unconverged = 0;
+  for (const auto& r : results) {
+    if (r.energy_error >= max_energy_error) max_energy_error = r.energy_error, worst_energy_f = r.frequency_hz;
+    unconverged += r.unconverged_pairs;
+  }
+  report_branch(j, response, equations, evaluator.n_pairs());
+  j["max_energy_balance_error"] = max_energy_error;
+  j["peak_amplitude_m"] = peak.amplitude_m;
+  j["peak_frequency_hz"] = peak.frequency_hz;
+  j["unconverged_periodic_pairs"] = unconverged;
+  ctx.report.stage("frf", clock.seconds());
+  if (unconverged > 0)
+    ctx.report.warn(std::to_string(unconverged) +
+                    " contact evaluations did not reach a periodic state within the period cap");
+  // A point whose excitation work and dissipation disagree is not a solution of the
+  // mechanics, whatever the residual says (e.g. a contact law that did not reach its periodic
+  // state): the run fails its own check (docs/continuation.md).
+  const bool energy_failed = max_energy_error > c.hbm.energy_tolerance;
+  j["energy_check_passed"] = !energy_failed;
+  j["polished_points"] = response.polished_points;
+  std::ostringstream s;
+  s << "frf: " << results.size() << " points, peak " << std::scientific << std::setprecision(4) << peak.amplitude_m
+    << " m at " << std::defaultfloat << std::setprecision(6) << peak.frequency_hz << " Hz, " << branch.turning_points
+    << " turning points, " << branch.newton_iterations << " Newton iterations, max energy-balance error "
+    << std::setprecision(2) << max_energy_error;
+  log::info(s.str());
+  ForcedResponseOutcome outcome;
+  if (energy_failed && branch.status == continuation::BranchStatus::kReachedEnd) {
+    outcome.failure = "the energy balance fails its check: error " + io::format_number(max_energy_error) + " at " +
+                      io::format_number(worst_energy_f) +
+                      " Hz exceeds hbm.energy_tolerance = " + io::format_number(c.hbm.energy_tolerance) +
+                      " (excitation work and dissipation per cycle disagree: raise hbm.time_samples, or relax "
+                      "hbm.energy_tolerance to accept the curve; " +
+                      std::to_string(results.size()) + " points written to frf.csv)";
+  } else if (branch.status != continuation::BranchStatus::kReachedEnd) {
+    outcome.failure = "continuation stopped: " + branch.message + " (" + std::to_string(results.size()) +
+                      " points written to frf.csv)";
+  }
+  if (!outcome.failure.empty()) j["failed"] = true;
+  return outcome;
+}
+
+/// hbm.harmonics and/or hbm.time_samples = "auto": the search of
+/// forced/discretization_search.hpp, each trial a full forced response into
+/// <out>/auto/H=..__N=../ compared in memory; the accepted trial's frf.csv, loops.csv and
+/// peaks.csv are the result, and run.json lists every trial under "auto".
+ForcedResponseOutcome search_discretization(Context& ctx) {
+  const io::Case& c = ctx.config;
+  log::Stopwatch clock;
+  const bool verbose = log::verbose();
+  std::vector<nlohmann::json> frf_sections;  // each trial's run.json "frf", in order
+  std::vector<std::filesystem::path> dirs;
+  auto run_trial = [&](int h, int n) {
+    forced::DiscretizationTrial t;
+    Context tc;
+    tc.config = c;
+    tc.config.hbm.harmonics = h;
+    tc.config.hbm.harmonics_auto = false;
+    tc.config.hbm.time_samples = n;
+    tc.config.hbm.time_samples_auto = false;
+    tc.out_dir = ctx.out_dir / "auto" / ("H=" + std::to_string(h) + "__N=" + std::to_string(n));
+    tc.threads = ctx.threads;
+    tc.overrides = ctx.overrides;
+    tc.plots = false;
+    log::set_verbose(false);
+    try {
+      t.message = trace_case(tc).failure;
+      t.ok = t.message.empty();
+    } catch (const NumericalError& e) {
+      t.message = e.what();
+    } catch (...) {
+      log::set_verbose(verbose);
+      throw;
+    }
+    log::set_verbose(verbose);
+    const nlohmann::json frf = tc.report.json().value("frf", nlohmann::json::object());
+    t.peak_amplitude_m = frf.value("peak_amplitude_m", 0.0);
+    t.peak_frequency_hz = frf.value("peak_frequency_hz", 0.0);
+    t.curve = std::move(tc.frf_curve);
+    frf_sections.push_back(frf);
+    dirs.push_back(tc.out_dir);
+    return t;
+  };
+  auto report_trial = [&](const forced::DiscretizationTrial& t) {
+    std::ostringstream s;
+    s << "frf: auto: H = " << t.harmonics << ", N = " << t.time_samples << ": "
+      << (t.ok ? "peak " : "failed (" + t.message + "), peak so far ") << std::scientific << std::setprecision(4)
+      << t.peak_amplitude_m << " m at " << std::defaultfloat << std::setprecision(6) << t.peak_frequency_hz << " Hz";
+    if (t.relative_change >= 0) s << ", change " << std::setprecision(2) << 100 * t.relative_change << " %";
+    s << " (" << std::setprecision(3) << t.seconds << " s)";
+    log::info(s.str());
+  };
+  forced::DiscretizationSettings settings;
+  settings.harmonics_auto = c.hbm.harmonics_auto;
+  settings.time_samples_auto = c.hbm.time_samples_auto;
+  settings.harmonics = c.hbm.harmonics;
+  settings.time_samples = c.hbm.time_samples;
+  settings.max_harmonics = c.hbm.auto_max_harmonics;
+  settings.max_time_samples = c.hbm.auto_max_time_samples;
+  settings.tolerance = c.hbm.auto_tolerance;
+  forced::DiscretizationSearch search;
+  try {
+    search = forced::search_discretization(settings, run_trial, report_trial);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.locations.at("hbm.harmonics") + ": hbm \"auto\": " + e.what());
+  }
+  const forced::DiscretizationTrial& chosen = search.trials[search.chosen];
+  const std::filesystem::path& chosen_dir = dirs[search.chosen];
+  for (const char* f : {"frf.csv", "loops.csv", "peaks.csv"})
+    if (std::filesystem::exists(chosen_dir / f))
+      io::write_file_atomic(ctx.out_dir / f, study::read_file(chosen_dir / f));
+  ctx.frf_curve = chosen.curve;
+  ctx.report.section("frf") = frf_sections[search.chosen];
+  const double tol = settings.tolerance;
+  const int h = search.harmonics, n = search.time_samples;
+  auto& a = ctx.report.section("auto");
+  a["tolerance"] = tol;
+  a["harmonics"] = h;
+  a["time_samples"] = n;
+  a["harmonics_converged"] = search.harmonics_converged;
+  a["time_samples_converged"] = search.time_samples_converged;
+  a["trials"] = nlohmann::json::array();
+  for (const auto& t : search.trials)
+    a["trials"].push_back(
+        {{"harmonics", t.harmonics},
+         {"time_samples", t.time_samples},
+         {"status", t.ok ? "ok" : "numerics_failed"},
+         {"peak_amplitude_m", t.peak_amplitude_m},
+         {"peak_frequency_hz", t.peak_frequency_hz},
+         {"seconds", t.seconds},
+         {"relative_change", t.relative_change >= 0 ? nlohmann::json(t.relative_change) : nlohmann::json(nullptr)}});
+  ctx.report.stage("frf", clock.seconds());
+  log::info("frf: auto chose H = " + std::to_string(h) + ", N = " + std::to_string(n) + " (" +
+            std::to_string(search.trials.size()) + " trials)");
+  if (!search.harmonics_converged)
+    ctx.report.warn("hbm.harmonics = \"auto\": the peak still changed by more than " + io::format_number(tol) +
+                    " at H = " + std::to_string(h) +
+                    " (hbm.auto_max_harmonics or the fixed time_samples stopped the search)");
+  if (!search.time_samples_converged)
+    ctx.report.warn("hbm.time_samples = \"auto\": the peak still changed by more than " + io::format_number(tol) +
+                    " at N = " + std::to_string(n) + " (hbm.auto_max_time_samples)");
+  ForcedResponseOutcome outcome;
+  if (!chosen.ok)
+    outcome.failure = "with H = " + std::to_string(h) + ", N = " + std::to_string(n) + ": " + chosen.message;
+  return outcome;
+}
+
+}  // namespace
+
+ForcedResponseOutcome run_forced_response(Context& ctx) {
+  const io::Case& c = ctx.config;
+  if (c.excitation.force[0] == 0.0 && c.excitation.force[1] == 0.0 && c.excitation.force[2] == 0.0) {
+    throw InputError(c.where("excitation.force") +
+                     ": excitation.force is zero: the forced response is the trivial zero solution (nothing to trace)");
+  }
+  if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return search_discretization(ctx);
+  return trace_case(ctx);
+}
+
+}  // namespace shroudsim::pipeline

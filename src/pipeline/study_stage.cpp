@@ -1,0 +1,327 @@
+// The study stages: see study_stage.hpp.
+#include "pipeline/study_stage.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <ctime>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "io/output.hpp"
+#include "linalg/parallel.hpp"
+#include "study/curves.hpp"
+#include "study/trade_design.hpp"
+
+namespace shroudsim::pipeline {
+namespace {
+
+struct StudyPoint {
+  std::vector<std::pair<std::string, std::string>> values;  ///< key, TOML value text
+  std::string folder;
+  int status = -1;
+  std::string message;
+  double peak = 0.0, peak_frequency = 0.0, seconds = 0.0;
+  double cpu_seconds = 0.0;  ///< CPU time of the point's own thread (points run with threads = 1)
+  std::size_t points = 0;
+};
+
+std::string folder_name(const std::vector<std::pair<std::string, std::string>>& values) {
+  std::string s;
+  for (const auto& [k, v] : values) {
+    std::string key = k.substr(k.rfind('.') + 1), val = v;
+    val.erase(std::remove(val.begin(), val.end(), '"'), val.end());
+    for (char& ch : val)
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '-' && ch != '_') ch = '_';
+    s += (s.empty() ? "" : "__") + key + "=" + val;
+  }
+  return s;
+}
+
+/// CPU time of the calling thread [s]: the cost of a study point whatever else the machine
+/// (or the other workers) is doing.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// Runs every point (the case `cases[i]` into <out>/<points[i].folder>) on --threads workers,
+/// quietly, one line each; fills status, message, peak, points and seconds. Returns the
+/// number of workers used.
+int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<StudyPoint>& points,
+               const CaseRunner& run_case) {
+  const int workers = linalg::worker_count(ctx.threads, static_cast<int>(points.size()));
+  log::info("study: " + std::to_string(points.size()) + " points on " + std::to_string(workers) + " workers");
+  const bool verbose = log::verbose();
+  log::set_verbose(false);  // points run quietly; one line each below
+  std::mutex out;
+  // Serial BLAS even with one worker: a point's cost is its thread's CPU time.
+  linalg::SerialBlasScope serial;
+  linalg::parallel_for(static_cast<int>(points.size()), workers, [&](int i) {
+    {
+      Context pc;
+      pc.config = cases[i];
+      pc.out_dir = ctx.out_dir / points[i].folder;
+      pc.threads = 1;
+      pc.plots = false;
+      log::Stopwatch clock;
+      const double cpu0 = thread_cpu_seconds();
+      StudyPoint& p = points[i];
+      try {
+        p.status = run_case(pc);
+      } catch (const InputError& e) {
+        p.status = 2, p.message = e.what();
+      } catch (const NumericalError& e) {
+        p.status = 3, p.message = e.what();
+      } catch (const std::exception& e) {
+        p.status = 1, p.message = e.what();
+      }
+      p.seconds = clock.seconds();
+      p.cpu_seconds = thread_cpu_seconds() - cpu0;
+      const auto& j = pc.report.json();
+      if (j.contains("frf")) {
+        p.peak = j["frf"].value("peak_amplitude_m", 0.0);
+        p.peak_frequency = j["frf"].value("peak_frequency_hz", 0.0);
+        p.points = j["frf"].value("points", std::size_t{0});
+      }
+      nlohmann::json rj = j;
+      rj["status"] = p.status == 0 ? "ok" : "failed";
+      if (!p.message.empty()) rj["message"] = p.message;
+      rj["case"] = nlohmann::json::parse(pc.config.resolved_json);
+      try {
+        io::write_file_atomic(pc.out_dir / "run.json", rj.dump(2) + "\n");
+      } catch (const std::exception&) {
+      }
+      std::lock_guard<std::mutex> lock(out);
+      if (verbose) {
+        std::ostringstream s;
+        s << "shroudsim: study: " << p.folder << ": " << (p.status == 0 ? "ok" : "failed (" + p.message + ")")
+          << ", peak " << std::scientific << std::setprecision(4) << p.peak << " m at " << std::defaultfloat
+          << std::setprecision(6) << p.peak_frequency << " Hz, " << std::setprecision(3) << p.seconds << " s\n";
+        std::cerr << s.str();
+      }
+    }
+  });
+  log::set_verbose(verbose);
+  return workers;
+}
+
+/// `study --convergence`: every knob of the accuracy/speed trade varied one at a time around
+/// the case's own setting, each against its finest value (the reference), with every other
+/// knob at the case's setting. The error of a point is peaks_change (study/curves.hpp) between
+/// its curve and the reference's (the largest relative change at any resonance peak of the
+/// range) and peaks_shift_hz (the largest shift of such a peak); its cost is its wall time (a run
+/// that has to build a new mesh and its modes pays for them). -> trade.csv, trade.png.
+StudyOutcome run_convergence(Context& ctx, const CaseRunner& run_case) {
+  const io::Case& c = ctx.config;
+  auto num = [](double v) { return io::format_number(v); };
+  const std::vector<study::Knob> knobs = study::convergence_knobs(c);
+  if (knobs.empty()) throw InputError(c.file.string() + ": study --convergence: this case has no knob to vary");
+
+  // Points: one per distinct set of overrides (the case itself appears under several knobs).
+  std::vector<StudyPoint> points;
+  std::map<std::string, std::size_t> index;
+  auto point_of = [&](std::vector<std::pair<std::string, std::string>> values) {
+    std::sort(values.begin(), values.end());
+    // Overrides equal to the case's own setting are dropped, so equal points merge.
+    std::vector<std::pair<std::string, std::string>> kept;
+    for (const auto& [k, v] : values) {
+      const io::Case probe = io::load_case(c.file, [&] {
+        std::vector<std::string> sets = ctx.overrides;
+        sets.push_back(k + "=" + v);
+        return sets;
+      }());
+      if (probe.resolved_json != c.resolved_json) kept.emplace_back(k, v);
+    }
+    const std::string name = kept.empty() ? "case" : folder_name(kept);
+    auto [it, fresh] = index.emplace(name, points.size());
+    if (fresh) {
+      StudyPoint p;
+      p.values = kept;
+      p.folder = name;
+      points.push_back(p);
+    }
+    return it->second;
+  };
+  struct Row {
+    std::size_t knob, point, reference;
+    std::string value;
+  };
+  std::vector<Row> rows;
+  std::vector<std::string> reference_label(knobs.size());
+  try {
+    for (std::size_t k = 0; k < knobs.size(); ++k) {
+      // Every value at the case's other settings; the reference is the finest value, with
+      // the knob's extra overrides (e.g. more samples for more harmonics) when it has some,
+      // listed as a row of its own.
+      auto ref = knobs[k].reference;
+      ref.emplace_back(knobs[k].key, knobs[k].values.back());
+      const std::size_t r = point_of(ref);
+      reference_label[k] = knobs[k].values.back();
+      for (const auto& [key, value] : knobs[k].reference) reference_label[k] += " " + key + "=" + value;
+      for (const auto& v : knobs[k].values) rows.push_back({k, point_of({{knobs[k].key, v}}), r, v});
+      if (!knobs[k].reference.empty()) rows.push_back({k, r, r, reference_label[k]});
+    }
+  } catch (const InputError& e) {
+    throw InputError(c.file.string() + ": study --convergence: a varied value is not valid for this case: " + e.what());
+  }
+  std::vector<io::Case> cases;
+  for (const auto& p : points) {
+    std::vector<std::string> sets = ctx.overrides;
+    for (const auto& [k, v] : p.values) sets.push_back(k + "=" + v);
+    cases.push_back(io::load_case(c.file, sets));
+  }
+  log::info("study --convergence: " + std::to_string(knobs.size()) + " knobs, " + std::to_string(points.size()) +
+            " runs");
+  log::Stopwatch clock;
+  const int workers = run_points(ctx, cases, points, run_case);
+  ctx.report.stage("study", clock.seconds());
+
+  std::ostringstream csv;
+  csv << "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,peaks_error,"
+         "peak_frequency_error_hz,folder,cpu_seconds\n";
+  int failed = 0;
+  for (const auto& row : rows) {
+    const StudyPoint& p = points[row.point];
+    const StudyPoint& r = points[row.reference];
+    const bool ok = p.status == 0 && r.status == 0;
+    double err = 0.0, ferr = 0.0;
+    if (ok) {
+      const auto cp = study::read_curve(ctx.out_dir / p.folder / "frf.csv"),
+                 cr = study::read_curve(ctx.out_dir / r.folder / "frf.csv");
+      err = study::peaks_change(cp, cr);
+      ferr = study::peaks_shift_hz(cp, cr);
+    }
+    std::string value = row.value, ref = reference_label[row.knob];
+    for (std::string* t : {&value, &ref}) t->erase(std::remove(t->begin(), t->end(), '"'), t->end());
+    csv << knobs[row.knob].name << "," << knobs[row.knob].key << "," << value << "," << ref << ","
+        << (p.status == 0 ? "ok" : "failed") << "," << num(p.seconds) << "," << p.points << "," << num(p.peak) << ","
+        << num(p.peak_frequency) << "," << (ok ? num(err) : "") << "," << (ok ? num(ferr) : "") << "," << p.folder
+        << "," << num(p.cpu_seconds) << "\n";
+    failed += p.status != 0;
+  }
+  io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());
+  ctx.report.section("study") = {{"convergence", true},
+                                 {"runs", points.size()},
+                                 {"knobs", knobs.size()},
+                                 {"failed_rows", failed},
+                                 {"workers", workers}};
+  // The mesh ladder: observed order and extrapolated peak (docs/contact_patches.md).
+  for (std::size_t k = 0; k < knobs.size(); ++k) {
+    if (knobs[k].key != "geometry.mesh_size") continue;
+    std::vector<double> sizes, peaks;
+    bool all_ok = true;
+    for (const auto& row : rows)
+      if (row.knob == k) {
+        sizes.push_back(std::stod(row.value));
+        peaks.push_back(points[row.point].peak);
+        all_ok = all_ok && points[row.point].status == 0;
+      }
+    if (!all_ok || peaks.size() < 3) continue;
+    const study::MeshConvergence mc = study::mesh_convergence(peaks, study::kMeshRatio);
+    nlohmann::json j = {{"mesh_sizes_m", sizes},
+                        {"peaks_m", peaks},
+                        {"case_peak_m", peaks.front()},
+                        {"finest_peak_m", peaks.back()},
+                        {"monotone", mc.monotone}};
+    j["observed_order"] = mc.monotone ? nlohmann::json(mc.order) : nlohmann::json(nullptr);
+    j["extrapolated_peak_m"] = mc.monotone ? nlohmann::json(mc.extrapolated) : nlohmann::json(nullptr);
+    j["case_error_estimate"] = mc.case_error;
+    ctx.report.section("mesh_convergence") = j;
+    std::ostringstream s;
+    s << "study --convergence: mesh: peak " << io::format_number(peaks.front()) << " m at the case's size, "
+      << io::format_number(peaks.back()) << " m at the finest";
+    if (mc.monotone)
+      s << "; observed order " << std::setprecision(3) << mc.order << ", extrapolated "
+        << io::format_number(mc.extrapolated) << " m";
+    else s << "; not monotone over the three finest sizes (no extrapolation)";
+    s << "; estimated mesh error of the case: " << std::setprecision(3) << 100.0 * mc.case_error << " %";
+    log::info(s.str());
+  }
+  StudyOutcome outcome;
+  if (failed) outcome.warning = std::to_string(failed) + " rows of trade.csv failed (see their folders' run.json)";
+  return outcome;
+}
+
+}  // namespace
+
+StudyOutcome run_study(Context& ctx, const CaseRunner& run_case) {
+  if (ctx.convergence) return run_convergence(ctx, run_case);
+  const io::Case& base = ctx.config;
+  if (base.study.vary.empty())
+    throw InputError(base.locations.at("study.vary") + ": study.vary is empty: name at least one key and its values");
+  // Bounded work: the product's size before any point is built.
+  constexpr double kMaxStudyPoints = 10000;
+  double count = 1;
+  for (const auto& [key, values] : base.study.vary) count *= static_cast<double>(values.size());
+  if (count > kMaxStudyPoints)
+    throw InputError(base.locations.at("study.vary") + ": study.vary spans " + io::format_number(count) +
+                     " points (the product of its value lists), more than " + io::format_number(kMaxStudyPoints) +
+                     " a study runs; split it into several studies");
+  // Cartesian product, first key slowest.
+  std::vector<StudyPoint> points(1);
+  for (const auto& [key, values] : base.study.vary) {
+    std::vector<StudyPoint> next;
+    for (const auto& p : points)
+      for (const auto& v : values) {
+        StudyPoint q = p;
+        q.values.emplace_back(key, v);
+        next.push_back(q);
+      }
+    points = next;
+  }
+  // Every point is validated before any runs: a bad value is an input error up front.
+  std::vector<io::Case> cases;
+  for (auto& p : points) {
+    std::vector<std::string> sets = ctx.overrides;
+    for (const auto& [k, v] : p.values) sets.push_back(k + "=" + v);
+    try {
+      cases.push_back(io::load_case(base.file, sets));
+    } catch (const InputError& e) {
+      throw InputError(base.locations.at("study.vary") + ": study point " + folder_name(p.values) + ": " + e.what());
+    }
+    p.folder = folder_name(p.values);
+  }
+  // Values that sanitize to one folder name ("a/b.msh" and "a_b.msh") get a suffix of
+  // their own (the point's index), so that no point overwrites another.
+  {
+    std::map<std::string, int> uses;
+    for (const auto& p : points) ++uses[p.folder];
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (uses[points[i].folder] > 1) points[i].folder += "__point" + std::to_string(i + 1);
+  }
+  const int workers = run_points(ctx, cases, points, run_case);
+
+  std::ostringstream csv;
+  for (const auto& [k, v] : points.front().values) csv << k << ",";
+  csv << "status,peak_amplitude_m,peak_frequency_hz,points,seconds,folder\n";
+  int failed = 0;
+  for (const auto& p : points) {
+    for (const auto& [k, v] : p.values) {
+      std::string val = v;
+      val.erase(std::remove(val.begin(), val.end(), '"'), val.end());
+      csv << val << ",";
+    }
+    csv << (p.status == 0 ? "ok" : "failed") << "," << io::format_number(p.peak) << ","
+        << io::format_number(p.peak_frequency) << "," << p.points << "," << io::format_number(p.seconds) << ","
+        << p.folder << "\n";
+    failed += p.status != 0;
+  }
+  io::write_file_atomic(ctx.out_dir / "study.csv", csv.str());
+  ctx.report.section("study") = {{"points", points.size()}, {"failed", failed}, {"workers", workers}};
+  StudyOutcome outcome;
+  if (failed)
+    outcome.warning =
+        std::to_string(failed) + " of " + std::to_string(points.size()) + " study points failed (see study.csv)";
+  return outcome;
+}
+
+}  // namespace shroudsim::pipeline

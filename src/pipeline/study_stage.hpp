@@ -1,0 +1,38 @@
+#pragma once
+// Studies over a case (`shroudsim study`). A study point is the case with the point's values
+// as --set overrides (after the command line's own), run by the caller's case runner (the
+// app's `run`: every stage the case asks for) in its own folder <out>/<key=value__...>/ with
+// its own run.json, quietly and with one thread each; points run in parallel on --threads
+// workers, their cost measured as the CPU time of their thread.
+//
+//   - the [study] vary grid: the Cartesian product of the value lists (first key slowest),
+//     every point validated before any runs -> study.csv (status, peak amplitude and
+//     frequency, points, seconds and folder of every point);
+//   - `study --convergence` (Context::convergence): every knob of the accuracy/speed trade
+//     (study/trade_design.hpp) varied one at a time around the case's own setting, each
+//     against its finest value -> trade.csv and, for the mesh ladder, the observed order and
+//     extrapolated peak in run.json "mesh_convergence" (docs/contact_patches.md).
+//
+// A failed point is recorded (status and reason in its folder's run.json and in the table)
+// and the study goes on; the caller exits 3 when any failed.
+#include <functional>
+#include <string>
+
+#include "pipeline/context.hpp"
+
+namespace shroudsim::pipeline {
+
+/// Runs one case in a prepared context and returns its exit status (0, 2, 3), or throws
+/// InputError / NumericalError.
+using CaseRunner = std::function<int(Context&)>;
+
+struct StudyOutcome {
+  std::string warning;  ///< empty: every point (row) ran; otherwise how many failed
+};
+
+/// The study of ctx.config (the vary grid, or the convergence study when ctx.convergence)
+/// into ctx.out_dir; the report's "study" section. Throws InputError for an empty or too
+/// large grid or a point whose values do not make a valid case.
+StudyOutcome run_study(Context& ctx, const CaseRunner& run_case);
+
+}  // namespace shroudsim::pipeline
