@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # shroudsim set-up on a Debian 12 machine: installs the missing Debian packages (quietly,
 # only when something is missing), configures and builds (Release), then
-#   tools/setup.sh demo   runs the default case end to end (cases/shrouded_blade.toml)
+#   tools/setup.sh demo   runs the default case end to end (cases/shrouded_wheel.toml)
 #   tools/setup.sh test   runs the whole test suite (ctest)
 #   tools/setup.sh build  only installs and builds
 # Needs root (or sudo) only when a package is missing. SHROUDSIM_BUILD_DIR (default build)
@@ -45,7 +45,7 @@ if ! cmake --build "$build" -j "$jobs" >"$build/build.log" 2>&1; then
 fi
 
 case "$mode" in
-  demo) exec "$build/src/app/shroudsim" run cases/shrouded_blade.toml ;;
+  demo) exec "$build/src/app/shroudsim" run cases/shrouded_wheel.toml ;;
   test) exec ctest --test-dir "$build" --output-on-failure -j "$jobs" ;;
   build) echo "setup: built $build/src/app/shroudsim" >&2 ;;
 esac

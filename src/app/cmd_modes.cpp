@@ -28,8 +28,14 @@ void draw_plots(Context& ctx) {
     return;
   }
   std::string cmd = std::string(python) + " '" + script.string() + "' '" + ctx.out_dir.string() + "'";
-  if (ctx.report.json().contains("modal") && ctx.report.json()["modal"].contains("shroud"))
-    cmd += " --shroud " + ctx.report.json()["modal"]["shroud"].get<std::string>();
+  // The shroud state in the titles of nd_map.png and campbell.png: the Campbell stage's when
+  // there is one (in `run`, the forced response's open modal model comes after it).
+  const nlohmann::json& j = ctx.report.json();
+  for (const char* section : {"campbell", "modal"})
+    if (j.contains(section) && j[section].contains("shroud")) {
+      cmd += " --shroud " + j[section]["shroud"].get<std::string>();
+      break;
+    }
   const int rc = std::system(cmd.c_str());
   ctx.report.section("plots")["drawn"] = rc == 0;
   if (rc != 0) ctx.report.warn("plotting failed (" + cmd + ")");

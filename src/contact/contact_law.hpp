@@ -48,6 +48,12 @@ struct PairParameters {
   double normal_stiffness = 1.0e6;      ///< kn [N/m], > 0 (not used by the 1d models)
   double friction_coefficient = 0.3;    ///< mu [-], >= 0
   double normal_preload = 0.25;         ///< N0 [N]; < 0: initial gap -N0/kn (1d models: >= 0)
+  /// N0 is the normal load of a static equilibrium the linear model is written about
+  /// (contact.normal_preload = "static"): the structure already carries max(0, N0), so the
+  /// forced response's static harmonic balances only the change of the contact force from it
+  /// (docs/physics.md sections 3 and 8). false: N0 acts on the structure at zero relative
+  /// displacement, and the static harmonic balances it (the paper's preload).
+  bool preload_in_equilibrium = false;
 
   /// Appends one message per violated constraint ("key = value violates: ...", keys as in
   /// docs/contract.md [contact]); returns true when valid.

@@ -126,6 +126,7 @@ const ReducedEquations::Harmonics& ReducedEquations::harmonics(double frequency_
       harmonics_.g[n] = std::move(rec.G);
       harmonics_.w_lin[n] = std::move(rec.w_lin);
     }
+    harmonics_.w_static = harmonics_.g[0] * static_contact_load();
     harmonics_.frequency_hz = frequency_hz;
     harmonics_.derivative = false;
   }
@@ -258,6 +259,8 @@ bool ReducedEquations::evaluate_impl(const Eigen::VectorXd& w, double frequency_
   r = w + gf;
   for (int n = 0; n <= contacts_.pair_layout().n_harmonics(); ++n)
     add_harmonic(-excitation_scale_ * hs.w_lin[static_cast<std::size_t>(n)], n, r);
+  // r_0 = W_0 + G_0 (F_0 - F_s) about a static state (G_0 does not depend on the frequency).
+  add_harmonic(-hs.w_static, 0, r);
   if (dr_dlambda) {
     apply(hs.dg, f_, *dr_dlambda);
     for (int n = 0; n <= contacts_.pair_layout().n_harmonics(); ++n)
@@ -380,10 +383,21 @@ Eigen::VectorXd ReducedEquations::linear_motion(double frequency_hz) const {
   return w_lin;
 }
 
+Eigen::VectorXcd ReducedEquations::static_contact_load() const {
+  Eigen::VectorXcd f = Eigen::VectorXcd::Zero(linear_.n_contact());
+  if (n_directions_ != 3) return f;
+  for (int p = 0; p < contacts_.n_pairs(); ++p) {
+    const auto& pp = contacts_.pairs()[static_cast<std::size_t>(p)];
+    if (pp.preload_in_equilibrium) f[3 * p + 2] = std::max(0.0, pp.normal_preload);
+  }
+  return f;
+}
+
 Eigen::VectorXd ReducedEquations::stuck_solution(double frequency_hz) const {
   // Stuck, closed contacts: F = Kc W + F_pre (F_pre: the preload in the static normal term).
   // Kc is diagonal and the same in every harmonic, so each harmonic is one complex c x c
-  // solve: (I + G_n Kc) W_n = s W_lin,n - G_n F_pre,n.
+  // solve: (I + G_n Kc) W_n = s W_lin,n - G_n (F_pre,n - F_s,n), F_s the static state's load
+  // (static_contact_load(): about a static state that carries the preload, W_0 = 0).
   const int h = contacts_.pair_layout().n_harmonics(), c = linear_.n_contact();
   Eigen::VectorXd kc = Eigen::VectorXd::Zero(c);
   Eigen::VectorXcd f_pre = Eigen::VectorXcd::Zero(c);
@@ -402,7 +416,7 @@ Eigen::VectorXd ReducedEquations::stuck_solution(double frequency_hz) const {
     Eigen::MatrixXcd a = rec.G * kc.asDiagonal();
     a.diagonal().array() += 1.0;
     Eigen::VectorXcd rhs = excitation_scale_ * rec.w_lin;
-    if (n == 0) rhs -= rec.G * f_pre;
+    if (n == 0) rhs -= rec.G * (f_pre - static_contact_load());
     add_harmonic(Eigen::PartialPivLU<Eigen::MatrixXcd>(a).solve(rhs), n, w);
   }
   return w;
@@ -419,9 +433,11 @@ PointResult ReducedEquations::analyse(const Eigen::VectorXd& w, double frequency
   for (int n = 0; n <= h; ++n) linear_.harmonic(n, omega, rec[n]);
   std::vector<Eigen::VectorXcd> u(h + 1), forces(h + 1);
   res.harmonic_amplitudes.resize(h + 1);
+  const Eigen::VectorXcd f_static = static_contact_load();
   for (int n = 0; n <= h; ++n) {
     forces[n] = complex_harmonic(f_, n);
-    u[n] = rec[n].u_lin - rec[n].H * forces[n];
+    // The response about the static state (its own load F_s excluded from the static part).
+    u[n] = rec[n].u_lin - rec[n].H * (n == 0 ? Eigen::VectorXcd(forces[n] - f_static) : forces[n]);
     res.harmonic_amplitudes[n] = u[n].norm();
   }
   // max over one period of |u(t)|, u(t) = Re sum_n U_n exp(i n theta).

@@ -143,8 +143,12 @@ class ReducedEquations : public continuation::ParametricResidual {
     bool derivative = false;
     std::vector<Eigen::MatrixXcd> g, dg;
     std::vector<Eigen::VectorXcd> w_lin, dw_lin;
+    Eigen::VectorXcd w_static;  ///< G_0 F_s: the static state's relative displacement (c)
   };
   const Harmonics& harmonics(double frequency_hz, bool derivative);
+  /// F_s (c, real): the contact forces of the static state the model is written about, the
+  /// normal max(0, N0) of every pair with PairParameters::preload_in_equilibrium, else 0.
+  Eigen::VectorXcd static_contact_load() const;
   /// Real form of G(w) (size x size) and W_lin(w) (size).
   void assemble(double frequency_hz, Eigen::MatrixXd& g, Eigen::VectorXd* w_lin,
                 std::vector<frf::HarmonicReceptance>* receptances = nullptr) const;

@@ -107,6 +107,7 @@ std::vector<contact::PairParameters> patch_parameters(const std::vector<ContactP
     pp.normal_stiffness = face.normal_stiffness * s;
     pp.normal_preload = face.normal_preload * s;
     if (state) {
+      pp.preload_in_equilibrium = true;
       pp.normal_preload = 0.0;
       for (int member : p.members) {
         const auto& r = state->results[static_cast<std::size_t>(member)];

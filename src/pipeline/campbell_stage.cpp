@@ -212,6 +212,9 @@ CampbellOutcome run_campbell(Context& ctx) {
   auto& report = ctx.report.section("campbell");
   report["rotating_effects"] = rotating;
   report["speed_points"] = np;
+  // The shroud state of the diagram (a later stage of `run`, the forced response, records
+  // its own open modal model under "modal").
+  report["shroud"] = ctx.report.json()["modal"]["shroud"];
 
   // Canonical harmonic indices (h and Nb - h share frequencies) that have modes at rest.
   Sweeps sweeps;

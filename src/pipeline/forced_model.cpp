@@ -92,7 +92,12 @@ ForcedModel make_sector_model(Context& ctx) {
     static_state =
         frf::solve_static_shroud(rest.mesh, rest.km, ops.get(), static_shroud_settings(c, c.excitation.speed_rpm));
   }
-  ModalModel modal = run_modal_stage(ctx, std::vector<int>(needed.begin(), needed.end()), /*keep_factors=*/true,
+  // The K_h factors (static and residual flexibility) are always computed on demand, never
+  // kept from a modal solve: the solve's factor (of the same K_h, computed inside the parallel
+  // modal solve) differs from it in round-off, so a run with the modes cached and one that solves them would
+  // give different curves where the continuation's path is sensitive to round-off (the
+  // default case: 649 points in two pieces against 343 in one, the same located peak).
+  ModalModel modal = run_modal_stage(ctx, std::vector<int>(needed.begin(), needed.end()), /*keep_factors=*/false,
                                      c.excitation.speed_rpm);  // > 0: the modes at that speed
   if (!modal.failures.empty()) throw NumericalError("modal stage failed: " + modal.failures.front());
   const mesh::Mesh& mesh = modal.mesh;

@@ -321,5 +321,52 @@ TEST(ForcedLumped, Full3dResponseKeepsItsEnergyBalanceAndIsFrameInvariant) {
   EXPECT_NEAR(peaks[1] / peaks[0], 1.0, 1e-4);
 }
 
+// A preload that a static equilibrium already carries (contact.normal_preload = "static"):
+// the forced response is written about that state, so without excitation the solution is
+// W = 0 with every contact force at its static value; the paper's preload instead acts on
+// the structure at zero relative displacement, which the static harmonic relaxes to the
+// closed form N = N0 / (1 + kn c_n) of a spring in series with the structure's static
+// flexibility c_n (3 uncoupled DOFs to ground here: c_n = 1 / k_z).
+TEST(ForcedLumped, APreloadInEquilibriumIsTheStaticStateAndAnAppliedOneRelaxes) {
+  const double kz = 2.0e4, kn = 3.0e4, n0 = 5.0, f = 12.0;
+  frf::LumpedContact e;
+  e.dof = {0, 1, 2};
+  const Eigen::Vector3d k(1.0e4, 1.5e4, kz);
+  frf::LumpedLinearPart linear(Eigen::Matrix3d::Identity(), Eigen::Matrix3d(k.asDiagonal()),
+                               Eigen::Matrix3d(0.01 * k.asDiagonal()), {e}, 0, 1.0, 0);
+  hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = 3;
+  o.n_time_samples = 32;
+  o.law.model = contact::Model::full3d;
+  o.threads = 1;
+  for (const bool in_equilibrium : {true, false}) {
+    contact::PairParameters p;
+    p.tangential_stiffness = 1.0e4;
+    p.normal_stiffness = kn;
+    p.friction_coefficient = 0.3;
+    p.normal_preload = n0;
+    p.preload_in_equilibrium = in_equilibrium;
+    hbm::ContactEvaluator ev(o, {p});
+    ReducedEquations eq(linear, ev);
+    eq.set_excitation_scale(0.0);
+    const Eigen::VectorXd w = eq.stuck_solution(f);
+    Eigen::VectorXd r;
+    ASSERT_TRUE(eq.evaluate(w, f, r, nullptr, nullptr));
+    // The stuck solution solves the equations to round-off (the contact stays closed and
+    // stuck: its law is the linear one there). Scale: the preload's static deflection n0 / kz.
+    EXPECT_LT(r.lpNorm<Eigen::Infinity>(), 1e-12 * n0 / kz) << in_equilibrium;
+    hbm::PairDetail d;
+    ev.evaluate_pair(0, w, d, false);
+    const double normal = d.f.col(2).mean();
+    if (in_equilibrium) {
+      EXPECT_EQ(w.lpNorm<Eigen::Infinity>(), 0.0);
+      EXPECT_NEAR(normal, n0, 1e-12 * n0);
+    } else {
+      EXPECT_NEAR(normal, n0 / (1.0 + kn / kz), 1e-12 * n0);
+    }
+    EXPECT_NEAR(d.f.col(0).cwiseAbs().maxCoeff(), 0.0, 1e-12 * n0) << in_equilibrium;
+  }
+}
+
 }  // namespace
 }  // namespace shroudsim::forced
