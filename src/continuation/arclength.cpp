@@ -31,6 +31,7 @@ const char* to_string(BranchStatus status) {
   switch (status) {
     case BranchStatus::kReachedEnd: return "reached_end";
     case BranchStatus::kLeftRange: return "left_range";
+    case BranchStatus::kClosedLoop: return "closed_loop";
     case BranchStatus::kMaxPoints: return "max_points";
     case BranchStatus::kStepTooSmall: return "step_too_small";
     case BranchStatus::kStartFailed: return "start_failed";
@@ -74,6 +75,41 @@ void check_options(const ParametricResidual& residual, const Eigen::VectorXd& x,
   if (x.size() != residual.size())
     throw std::invalid_argument("continuation: the initial guess has size " + std::to_string(x.size()) +
                                 ", the residual " + std::to_string(residual.size()));
+}
+
+// Is the newest point (y, tangent t, reached by a step h) a point passed before, more than
+// kLoopGap points back, travelling the same way? A candidate lies within a twentieth of the
+// chord of an earlier step (a smooth branch is that close to its chords) with both tangents
+// along t; it is confirmed by the corrector from that step's first point onto the hyperplane
+// through y: the branch's own point there must be y to within kLoopTolerance times the
+// corrector's tolerance. A twin a sample away (the far side of a Z at a corner of a sampled
+// law, running alongside at the slab's width) stays at its own distance.
+bool closes_loop(ParametricResidual& residual, const ArclengthOptions& o, const std::vector<Eigen::VectorXd>& ys,
+                 const std::vector<BranchPoint>& points, const Eigen::VectorXd& y, const Eigen::VectorXd& t, double h) {
+  constexpr std::size_t kLoopGap = 8;
+  constexpr double kChordFraction = 0.05;
+  constexpr double kSameWay = 0.99;  // cosine between the tangents
+  constexpr double kLoopTolerance = 100.0;
+  const std::size_t m = ys.size();
+  if (m < kLoopGap + 2) return false;
+  const int n = static_cast<int>(y.size()) - 1;
+  for (std::size_t j = 0; j + kLoopGap + 1 < m; ++j) {
+    const Eigen::VectorXd& a = ys[j];
+    const Eigen::VectorXd& b = ys[j + 1];
+    const double lo = std::min(a[n], b[n]), hi = std::max(a[n], b[n]);
+    if (y[n] < lo - h || y[n] > hi + h) continue;  // cheap filter on lambda
+    const Eigen::VectorXd ab = b - a;
+    const double len2 = ab.squaredNorm();
+    if (!(len2 > 0)) continue;
+    const double u = std::clamp((y - a).dot(ab) / len2, 0.0, 1.0);
+    const double dist = (a + u * ab - y).norm();
+    const double len = std::sqrt(len2);
+    if (dist <= kChordFraction * std::min(len, h) && t.dot(points[j].tangent) > kSameWay &&
+        t.dot(points[j + 1].tangent) > kSameWay &&
+        distance_to_branch(residual, o, {points[j]}, points.back()) <= kLoopTolerance * o.tolerance)
+      return true;
+  }
+  return false;
 }
 
 double angle_between(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
@@ -193,7 +229,8 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
     if (it < 0 && h < steps.kink() && !corner_tried) {
       // No solution even at kink size: a corner of a nonsmooth branch.
       corner_tried = true;
-      if (cross_corner(s, y, t, steps.kink(), y_new, t_new, it, rnorm)) {
+      if (cross_corner(s, y, t, steps.kink(), y_new, t_new, it, rnorm) ||
+          turn_at_corner(s, y, t, steps.kink(), y_new, t_new, it, rnorm)) {
         ++branch.kinks_crossed;
         crossed_corner = true;
         h = (y_new - y).norm();
@@ -261,6 +298,10 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
     y = y_new;
     t = t_new;
     push(y, t, it, h, rnorm, PointKind::kRegular);
+    if (closes_loop(residual, o, ys, branch.points, y, t, h))
+      return finish(BranchStatus::kClosedLoop,
+                    "the branch closed on itself at lambda = " + std::to_string(s.lambda_of(y)) +
+                        " (it came back to a point passed before, travelling the same way)");
 
     // Reflection at a corner: back to the last point before the turn and over the corner.
     if (watch.observe(

@@ -117,7 +117,15 @@ struct BranchPoint {
   PointKind kind = PointKind::kRegular;
 };
 
-enum class BranchStatus { kReachedEnd, kLeftRange, kMaxPoints, kStepTooSmall, kStartFailed, kEvaluationFailed };
+enum class BranchStatus {
+  kReachedEnd,
+  kLeftRange,
+  kClosedLoop,  ///< the branch came back onto itself, travelling the same way (an isola)
+  kMaxPoints,
+  kStepTooSmall,
+  kStartFailed,
+  kEvaluationFailed
+};
 
 /// "reached_end", "left_range", ...
 const char* to_string(BranchStatus status);

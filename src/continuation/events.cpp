@@ -91,6 +91,55 @@ bool cross_corner(ScaledSystem& s, const Eigen::VectorXd& y, const Eigen::Vector
   return false;
 }
 
+bool turn_at_corner(ScaledSystem& s, const Eigen::VectorXd& y, const Eigen::VectorXd& t, double reach,
+                    Eigen::VectorXd& y_new, Eigen::VectorXd& t_new, int& iterations, double& rnorm) {
+  const double tol = s.options().tolerance;
+  Eigen::VectorXd r;
+  if (!s.evaluate(y, r, nullptr)) return false;
+  // The branch's own piece keeps R(y + h t) at its value at y up to second order; past the
+  // corner it grows linearly. "Left" = grown above a margin over the tolerance.
+  const double base = std::max(r.lpNorm<Eigen::Infinity>(), tol);
+  auto left = [&](double h) {
+    Eigen::VectorXd rh;
+    return !s.evaluate(y + h * t, rh, nullptr) || rh.lpNorm<Eigen::Infinity>() > 4.0 * base;
+  };
+  if (!left(reach)) return false;
+  double lo = 0.0, hi = reach;
+  constexpr int kBisections = 60;
+  for (int i = 0; i < kBisections && hi - lo > 1e-6 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (left(mid) ? hi : lo) = mid;
+  }
+  // Just past the corner: the other piece's Jacobian and its null vector.
+  const Eigen::VectorXd yk = y + hi * t;
+  Eigen::VectorXd tb;
+  if (!s.tangent(yk, t, t, tb)) return false;
+  // The orientation along which the residual stays flat, tried at growing distances.
+  for (double size : {1e-3, 1e-2, 1e-1, 1.0}) {
+    const double h = std::max(size * reach, 4.0 * (hi - lo));
+    double flat[2];
+    for (int k = 0; k < 2; ++k) {
+      Eigen::VectorXd rh;
+      flat[k] = s.evaluate(yk + (k ? -h : h) * tb, rh, nullptr) ? rh.lpNorm<Eigen::Infinity>()
+                                                                : std::numeric_limits<double>::infinity();
+    }
+    const double sign = flat[0] <= flat[1] ? 1.0 : -1.0;
+    const Eigen::VectorXd v = sign * tb;
+    const Eigen::VectorXd y_pred = yk + h * v;
+    Eigen::VectorXd yc = y_pred;
+    const int it = correct(s, yc, v, y_pred, rnorm);
+    if (it < 0 || (yc - y).norm() < 0.5 * h) continue;
+    // Not the piece the branch came along, traced backwards.
+    const Eigen::VectorXd d = yc - y;
+    if ((d - d.dot(t) * t).norm() < 1e-3 * d.norm()) continue;
+    if (!s.tangent(yc, v, v, t_new)) continue;
+    y_new = yc;
+    iterations = it;
+    return true;
+  }
+  return false;
+}
+
 bool ReflectionWatch::observe(const Eigen::VectorXd& y, double step,
                               const std::function<Eigen::VectorXd(std::size_t)>& scaled,
                               const std::function<double(std::size_t)>& step_to) {

@@ -37,6 +37,18 @@ bool locate_fold(ScaledSystem& s, const Eigen::VectorXd& y0, const Eigen::Vector
 bool cross_corner(ScaledSystem& s, const Eigen::VectorXd& y, const Eigen::VectorXd& t, double kink,
                   Eigen::VectorXd& y_new, Eigen::VectorXd& t_new, int& iterations, double& rnorm);
 
+/// Where no solution lies on the hyperplanes normal to t ahead of y, however small the step (the
+/// branch ends on the piece it came along: past a corner of the residual the only
+/// continuation turns back, possibly by nearly 180 degrees, e.g. across the steep slab of a
+/// very stiff sampled contact): the corner is located on the ray y + h t (h <= `reach`) as the
+/// first h where the residual leaves its value at y, the null vector of the Jacobian just past
+/// it is taken, and of its two orientations the one along which the residual stays flat (the
+/// residual's own piece, not the one the branch came along) is followed by the corrector. On
+/// success y_new, t_new (t_new along that orientation), the Newton iterations and residual
+/// norm; t_new may point back in lambda (the caller records a turning point).
+bool turn_at_corner(ScaledSystem& s, const Eigen::VectorXd& y, const Eigen::VectorXd& t, double reach,
+                    Eigen::VectorXd& y_new, Eigen::VectorXd& t_new, int& iterations, double& rnorm);
+
 /// After a fold: does the branch come back along the stretch traced before it? A sampled
 /// friction law can reflect the branch at a corner onto a twin of itself (a sample away),
 /// which then leads back through the start; a true fold leaves at a distance of the order of

@@ -146,5 +146,53 @@ TEST(CliContinuation, WithoutAResonanceInTheRangeThePeakIsTheLargestPoint) {
   EXPECT_EQ(frf["peak_amplitude_m"].get<double>(), largest);
 }
 
+TEST(CliContinuation, AVeryStiffSampledContactIsFollowedRoundTheCornersWhereItsBranchTurnsBack) {
+  // Stress corpus model 168: a 1d Jenkins contact 8,880 times stiffer than the structure,
+  // sampled on N = 64. The stick phase after each reversal is ~1e-5 of the sample spacing, so
+  // the sampled force is a staircase of steep slabs; at one of them (0.7366 Hz) the branch
+  // ends on its piece and turns back by ~166 degrees, where no hyperplane ahead meets it. The
+  // corrector used to stall there at every step size (exit 3); the turn at the corner follows
+  // the other piece (continuation::turn_at_corner) and the curve reaches the end.
+  const Scratch s("stiff_corner");
+  s.write("case.toml", R"(name = "stress_0168"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[8.28659034910023, 0.0, 0.0, 0.0], [0.0, 11.69038242952306, 0.0, 0.0], [0.0, 0.0, 6.186343951528171, 0.0], [0.0, 0.0, 0.0, 14.14799018959927]]
+stiffness = [[1215.0554328008352, 690.9986243479839, -171.73988641783225, -266.3964456487466], [690.9986243479839, 1252.832500977837, -673.2923994823614, 41.046485028175354], [-171.73988641783225, -673.2923994823614, 899.9359842918869, -382.2961917424062], [-266.3964456487466, 41.046485028175354, -382.2961917424062, 784.2393531359447]]
+damping = [[0.24903086649611597, 0.09310812308374238, -0.02314097006787495, -0.035895401490761814], [0.09310812308374238, 0.2891625877242719, -0.09072231028173805, 0.005530779722990761], [-0.02314097006787495, -0.09072231028173805, 0.18494862882751598, -0.051512231169468306], [-0.035895401490761814, 0.005530779722990761, -0.051512231169468306, 0.2513229995849307]]
+
+[excitation]
+force = 0.0005573659550485557
+dof = 1
+
+[response]
+dof = 1
+
+[contact]
+model = "1d"
+friction_coefficient = 0.4130197069319451
+tangential_stiffness = 9216894.689610455
+normal_stiffness = 2027.7335811873024
+normal_preload = 0.0017353467731309477
+
+[[contact.elements]]
+x_dof = 0
+
+[hbm]
+harmonics = 5
+time_samples = 64
+
+[continuation]
+frequency_start_hz = 0.5035226317992781
+frequency_end_hz = 1.006079560439476)");
+  const CliResult r = s.run("frf case.toml --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto frf = frf_of(s, "results/stress_0168");
+  EXPECT_TRUE(frf["energy_check_passed"].get<bool>());
+  EXPECT_GT(frf["kinks_crossed"].get<int>(), 0);
+}
+
 }  // namespace
 }  // namespace shroudsim::testing

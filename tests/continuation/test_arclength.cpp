@@ -413,3 +413,96 @@ TEST(ArclengthEvents, APieceJoinsItsOwnBranchAndNotATwin) {
 
 }  // namespace
 }  // namespace shroudsim::continuation
+
+namespace shroudsim::continuation {
+namespace {
+
+/// lambda = phi(x), phi piecewise linear with a Z: slope 1 up to x = 1, slope -a over
+/// (1, 1 + w), slope 1 again beyond. At x = 1 the branch turns back in lambda by
+/// 180 - 45 - atan(1/a) degrees: past the corner no hyperplane normal to the incoming tangent
+/// meets the middle piece, only the piece beyond it.
+class Zee : public ParametricResidual {
+ public:
+  static constexpr double a = 20.0, w = 0.05;
+  static double phi(double x) {
+    if (x < 1.0) return x;
+    if (x < 1.0 + w) return 1.0 - a * (x - 1.0);
+    return 1.0 - a * w + (x - 1.0 - w);
+  }
+  int size() const override { return 1; }
+  bool has_lambda_derivative() const override { return true; }
+  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J,
+                Eigen::VectorXd* dl) override {
+    const double s = x[0] < 1.0 ? 1.0 : x[0] < 1.0 + w ? -a : 1.0;
+    r = Eigen::VectorXd::Constant(1, l - phi(x[0]));
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, -s);
+    if (dl) *dl = Eigen::VectorXd::Constant(1, 1.0);
+    return true;
+  }
+};
+
+TEST(ArclengthEvents, ACornerThatTurnsTheBranchBackIsFollowedOntoTheOtherPiece) {
+  Zee zee;
+  ArclengthOptions o;
+  o.lambda_start = 0.0;
+  o.lambda_end = 2.0;
+  o.tolerance = 1e-12;
+  int evaluations = 0;
+  ScaledSystem s(zee, o, &evaluations);
+  const Eigen::VectorXd y = s.to_scaled(Eigen::VectorXd::Constant(1, 0.999), 0.999);
+  const Eigen::VectorXd t = Eigen::Vector2d(1.0, 1.0).normalized();  // along the first piece
+  Eigen::VectorXd y_new, t_new;
+  int iterations = 0;
+  double rnorm = 0.0;
+  ASSERT_TRUE(turn_at_corner(s, y, t, 0.01, y_new, t_new, iterations, rnorm));
+  // On the middle piece: a solution with 1 < x < 1 + w, heading along it (x up, lambda down).
+  const double x = y_new[0], l = y_new[1];
+  EXPECT_GT(x, 1.0);
+  EXPECT_LT(x, 1.0 + Zee::w);
+  EXPECT_NEAR(l, Zee::phi(x), 1e-12);
+  const Eigen::Vector2d middle = Eigen::Vector2d(1.0, -Zee::a).normalized();
+  EXPECT_NEAR(t_new.dot(middle), 1.0, 1e-12);
+  // The residual gives no continuation beyond the first piece's own end when nothing turns:
+  // on a straight piece the residual never leaves zero within reach.
+  const Eigen::VectorXd y0 = s.to_scaled(Eigen::VectorXd::Constant(1, 0.5), 0.5);
+  EXPECT_FALSE(turn_at_corner(s, y0, t, 0.01, y_new, t_new, iterations, rnorm));
+}
+
+/// x^2 + (lambda - 0.5)^2 = 0.09: a closed branch (an isola) inside the range once the
+/// branch may go below lambda_start.
+class Isola : public ParametricResidual {
+ public:
+  int size() const override { return 1; }
+  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd*) override {
+    r = Eigen::VectorXd::Constant(1, x[0] * x[0] + (l - 0.5) * (l - 0.5) - 0.09);
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, 2 * x[0]);
+    return true;
+  }
+};
+
+TEST(Arclength, AClosedBranchIsReportedOnceItComesBackOntoItself) {
+  Isola isola;
+  ArclengthOptions o;
+  o.lambda_start = 0.3;
+  o.lambda_end = 1.0;
+  o.start_slack = 0.5;
+  o.initial_step = 0.02;
+  const Branch b = trace(isola, Eigen::VectorXd::Constant(1, 0.2), o);
+  ASSERT_EQ(b.status, BranchStatus::kClosedLoop) << b.message;
+  EXPECT_EQ(b.turning_points, 2);
+  for (const auto& p : b.points) EXPECT_NEAR(p.x[0] * p.x[0] + (p.lambda - 0.5) * (p.lambda - 0.5), 0.09, 1e-7);
+  // One lap: the arclength travelled is the circumference, 2 pi 0.3, to within a few steps.
+  double arc = 0.0, largest = 0.0;
+  for (std::size_t i = 1; i < b.points.size(); ++i) {
+    const double chord =
+        std::hypot(b.points[i].x[0] - b.points[i - 1].x[0], b.points[i].lambda - b.points[i - 1].lambda);
+    arc += chord;
+    largest = std::max(largest, chord);
+  }
+  const double lap = 2 * std::numbers::pi * 0.3;
+  EXPECT_GT(arc, lap * 0.98);
+  EXPECT_LT(arc, lap + 2 * largest);
+}
+
+}  // namespace
+}  // namespace shroudsim::continuation
