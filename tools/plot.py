@@ -59,8 +59,9 @@ def main(argv):
             continue
         try:
             getattr(importlib.import_module(module), function)(result_dir)
-        except ModuleNotFoundError as e:
-            print(f"plot.py: no plotter for {filename} yet ({e})", file=sys.stderr)
+        except ModuleNotFoundError as e:  # an incomplete installation
+            print(f"plot.py: {filename}: the plotting module is missing ({e})", file=sys.stderr)
+            status = 1
         except Exception as e:  # a broken plot must not hide the others
             print(f"plot.py: {filename}: {e}", file=sys.stderr)
             status = 1

@@ -27,6 +27,7 @@ struct CommonOptions {
   std::vector<std::string> sets;
   std::string out;
   bool quiet = false;
+  bool verbose = false;
   int threads = 0;
   bool convergence = false;  ///< study only
 };
@@ -38,6 +39,7 @@ void add_common(CLI::App* sub, CommonOptions& o) {
       ->take_all();
   sub->add_option("--out", o.out, "result folder (default results/<name>)");
   sub->add_flag("--quiet,-q", o.quiet, "no progress output");
+  sub->add_flag("--verbose,-v", o.verbose, "a line per continuation point instead of one progress line");
   sub->add_option("--threads", o.threads, "worker threads (default: all cores)")->check(CLI::Range(0, 1024));
 }
 
@@ -156,6 +158,7 @@ int run_cli(int argc, char** argv) {
   }
   const CommonOptions& o = options[chosen];
   log::set_verbose(!o.quiet);
+  log::set_detailed(o.verbose && !o.quiet);
   log::Stopwatch clock;
 
   Context ctx;

@@ -1,9 +1,16 @@
 // `shroudsim modes`: the modal stage (pipeline/modal_stage.hpp) for the case's harmonic
 // indices -> modes.csv (the nodal diameter map), modes.vtu, nd_map.png; and the plots of
 // every command (draw_plots).
-#include <cstdlib>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <cerrno>
+
 #include <filesystem>
 #include <string>
+#include <system_error>
+#include <vector>
 
 #include "app/context.hpp"
 #include "core/error.hpp"
@@ -13,32 +20,76 @@
 #define SHROUDSIM_SOURCE_DIR "."
 #endif
 
+extern char** environ;
+
 namespace shroudsim::app {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+/// The plotting script: beside an installed program (<prefix>/bin/shroudsim ->
+/// <prefix>/share/shroudsim/plot.py), else in the source tree the program was built from.
+fs::path plot_script() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path().parent_path() / "share" / "shroudsim" / "plot.py";
+    if (fs::exists(installed, ec)) return installed;
+  }
+  return fs::path(SHROUDSIM_SOURCE_DIR) / "tools" / "plot.py";
+}
+
+/// Runs argv[0] with these arguments (no shell: paths with quotes or spaces pass unchanged),
+/// its output to /dev/null when `quiet`; the exit status, or -1 when it could not start.
+int run_program(const std::vector<std::string>& args, bool quiet) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  if (quiet) {
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  }
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
 void draw_plots(Context& ctx) {
   if (!ctx.plots) return;  // study points: the study plots once at the end
-  const fs::path script = fs::path(SHROUDSIM_SOURCE_DIR) / "tools" / "plot.py";
-  const char* python = "/usr/bin/python3";
-  if (!fs::exists(python) || !fs::exists(script) ||
-      std::system((std::string(python) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0) {
+  const fs::path script = plot_script();
+  const std::string python = "/usr/bin/python3";
+  if (!fs::exists(python) || !fs::exists(script) || run_program({python, "-c", "import matplotlib"}, true) != 0) {
     log::info("plots skipped (needs /usr/bin/python3 with matplotlib and " + script.string() + ")");
     ctx.report.section("plots")["drawn"] = false;
     return;
   }
-  std::string cmd = std::string(python) + " '" + script.string() + "' '" + ctx.out_dir.string() + "'";
+  std::vector<std::string> args{python, script.string(), ctx.out_dir.string()};
   // The shroud state in the titles of nd_map.png and campbell.png: the Campbell stage's when
   // there is one (in `run`, the forced response's open modal model comes after it).
   const nlohmann::json& j = ctx.report.json();
   for (const char* section : {"campbell", "modal"})
     if (j.contains(section) && j[section].contains("shroud")) {
-      cmd += " --shroud " + j[section]["shroud"].get<std::string>();
+      args.push_back("--shroud");
+      args.push_back(j[section]["shroud"].get<std::string>());
       break;
     }
-  const int rc = std::system(cmd.c_str());
+  const int rc = run_program(args, false);
   ctx.report.section("plots")["drawn"] = rc == 0;
-  if (rc != 0) ctx.report.warn("plotting failed (" + cmd + ")");
+  if (rc != 0) {
+    std::string cmd;
+    for (const auto& a : args) cmd += (cmd.empty() ? "" : " ") + a;
+    ctx.report.warn("plotting failed (exit " + std::to_string(rc) + ": " + cmd + ")");
+  }
 }
 
 int cmd_modes(Context& ctx) {

@@ -15,6 +15,17 @@ void info(const std::string& line);
 /// One line to stderr, always (warnings are never silenced).
 void warn(const std::string& line);
 
+/// Per-step detail (e.g. every continuation point): off unless --verbose.
+void set_detailed(bool detailed);
+bool detailed();
+
+/// A progress report that replaces the previous one: on a terminal one live line (rewritten
+/// in place, at most every 0.2 s); otherwise a plain line at most every 10 s. Silenced with
+/// info(). The next info() or warn() line, or progress_done(), ends the live line.
+void progress(const std::string& line);
+/// Ends the live progress line (a newline on a terminal), if one is shown.
+void progress_done();
+
 /// Wall-clock stopwatch, seconds.
 class Stopwatch {
  public:

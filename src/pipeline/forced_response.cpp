@@ -1,6 +1,7 @@
 // The forced-response stage: see forced_response.hpp.
 #include "pipeline/forced_response.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -153,17 +154,34 @@ ForcedResponseOutcome trace_case(Context& ctx) {
             ", N = " + std::to_string(c.hbm.time_samples) + ", " + contact::to_string(c.contact.model) + ", " +
             hbm::to_string(c.hbm.jacobian) + " Jacobian)");
   int reported = 0;
+  // Progress: the share of the range covered (the first piece from the start, a second one
+  // from the end), the point rate and the time left at that rate; with --verbose a line per
+  // point instead.
+  const double f0 = c.continuation.frequency_start_hz, f1 = c.continuation.frequency_end_hz;
+  double covered[2] = {0.0, 0.0};
+  const log::Stopwatch trace_clock;
   auto progress = [&](const continuation::BranchPoint& p, int piece) {
     ++reported;
-    if (log::verbose()) {
-      std::ostringstream s;
+    std::ostringstream s;
+    if (log::detailed()) {
       s << "frf: point " << reported << (piece ? " (piece 2)" : "") << "  f = " << std::setprecision(7) << p.lambda
         << " Hz  step " << std::setprecision(3) << p.step << "  newton " << p.newton_iterations;
       log::info(s.str());
+      return;
     }
+    const double share = (piece == 0 ? p.lambda - f0 : f1 - p.lambda) / (f1 - f0);
+    covered[piece] = std::clamp(std::max(covered[piece], share), 0.0, 1.0);
+    const double done = std::min(1.0, covered[0] + covered[1]), seconds = trace_clock.seconds();
+    s << "frf: " << reported << " points, " << std::setprecision(6) << p.lambda << " Hz" << (piece ? " (piece 2)" : "")
+      << ", " << std::setprecision(3) << 100.0 * done << " % of the range, " << std::setprecision(3)
+      << reported / std::max(seconds, 1e-9) << " points/s";
+    if (done > 0.02 && done < 1.0)
+      s << ", about " << std::setprecision(2) << seconds * (1.0 - done) / done << " s left";
+    log::progress(s.str());
   };
   const forced::FrequencyResponse response = forced::trace_frequency_response(
       frequency_response_settings(c), model, eo, equations, progress, [](const std::string& s) { log::info(s); });
+  log::progress_done();
   const continuation::Branch& branch = response.summary;
   const std::vector<forced::PointResult>& results = response.results;
   auto& j = ctx.report.section("frf");
