@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <functional>
@@ -74,12 +75,29 @@ void print_summary(const Context& ctx, const std::string& command, double second
   std::ostringstream s;
   s << std::fixed << std::setprecision(2) << command << " finished in " << seconds << " s";
   if (ctx.report.json().contains("stages")) {
-    s << " (";
-    bool first = true;
+    // Once per stage, in the order they first ran: a stage that ran several times (the
+    // modal stage at each speed of a Campbell sweep) shows its total time and count.
+    struct Total {
+      std::string name;
+      double seconds = 0.0;
+      int runs = 0, reused = 0;
+    };
+    std::vector<Total> totals;
     for (const auto& st : ctx.report.json()["stages"]) {
-      s << (first ? "" : ", ") << st["name"].get<std::string>() << " " << st["seconds"].get<double>() << " s"
-        << (st["reused"].get<bool>() ? " reused" : "");
-      first = false;
+      const std::string name = st["name"].get<std::string>();
+      auto it = std::find_if(totals.begin(), totals.end(), [&](const Total& t) { return t.name == name; });
+      if (it == totals.end()) it = totals.insert(totals.end(), Total{name});
+      it->seconds += st["seconds"].get<double>();
+      ++it->runs;
+      it->reused += st["reused"].get<bool>() ? 1 : 0;
+    }
+    s << " (";
+    for (std::size_t i = 0; i < totals.size(); ++i) {
+      const Total& t = totals[i];
+      s << (i ? ", " : "") << t.name << " " << t.seconds << " s";
+      if (t.runs > 1) s << " x" << t.runs;
+      if (t.reused == t.runs) s << " reused";
+      else if (t.reused > 0) s << " (" << t.reused << " reused)";
     }
     s << ")";
   }

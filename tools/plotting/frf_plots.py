@@ -56,7 +56,16 @@ def plot_frf(result_dir):
         for r in _read_csv(peaks_csv):
             if float(r["amplitude_m"]) >= pa:
                 pf, pa = float(r["frequency_hz"]), float(r["amplitude_m"])
-    ax.plot([pf], [pa], "o", color="C3", label=f"peak {pa:.4g} m at {pf:.3f} Hz")
+    ax.plot([pf], [pa], "o", color="C3", label=f"peak {pa:.4g} m at {pf:.6g} Hz")
+    # Every located peak (peaks.csv), labelled with its frequency and amplitude.
+    if os.path.exists(peaks_csv):
+        for r in _read_csv(peaks_csv):
+            if r.get("located", "1") not in ("1", "true"):
+                continue
+            rf, ra = float(r["frequency_hz"]), float(r["amplitude_m"])
+            ax.plot([rf], [ra], "v", color="C3", ms=5)
+            ax.annotate(f"{rf:.6g} Hz\n{ra:.3g} m", (rf, ra), textcoords="offset points", xytext=(6, 6),
+                        fontsize=7, color="C3")
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("response amplitude max_t |u(t)| [m]")
     ax.set_ylim(bottom=max(min(a) * 1e-3, 1e-14))
@@ -72,24 +81,83 @@ def plot_frf(result_dir):
         plot_loops(result_dir)
 
 
+def scale_unit(values, unit):
+    """(factor, label): an SI prefix for `unit` that puts the largest |value| between 1 and 1000
+    (the axes then read 12.5 um, not 0.0000125 m)."""
+    big = max((abs(v) for v in values), default=0.0)
+    for factor, prefix in ((1e-9, "n"), (1e-6, "\u00b5"), (1e-3, "m"), (1.0, ""), (1e3, "k"), (1e6, "M")):
+        if big < 1000.0 * factor:
+            return factor, prefix + unit
+    return 1e6, "M" + unit
+
+
+def main_direction(fx, fy):
+    """Unit vector of the tangential force's main direction over the period: the principal
+    axis of its samples (x for a 1D contact, whose y force is zero)."""
+    n = len(fx)
+    mx, my = sum(fx) / n, sum(fy) / n
+    sxx = sum((a - mx) ** 2 for a in fx)
+    syy = sum((b - my) ** 2 for b in fy)
+    sxy = sum((a - mx) * (b - my) for a, b in zip(fx, fy))
+    if sxx + syy == 0.0:
+        return 1.0, 0.0
+    import math
+    angle = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
+    return math.cos(angle), math.sin(angle)
+
+
 def plot_loops(result_dir):
+    """loops.png: per pair, the tangential loop (force against displacement, both along the
+    force's main direction), the orbit of the relative tangential motion, and the normal loop;
+    displacements and forces in the SI prefix that fits them."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import ScalarFormatter
 
     rows = _read_csv(os.path.join(result_dir, "loops.csv"))
+    if not rows:
+        return
     pairs = sorted({int(r["pair"]) for r in rows})
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
-    for p in pairs:
+    shown = pairs[:8]
+    col = {k: [float(r[k]) for r in rows] for k in ("x_m", "y_m", "z_m", "tx_n", "ty_n", "n_n")}
+    du, dlabel = scale_unit(col["x_m"] + col["y_m"] + col["z_m"], "m")
+    fu, flabel = scale_unit(col["tx_n"] + col["ty_n"] + col["n_n"], "N")
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.4))
+    for p in shown:
         sel = [r for r in rows if int(r["pair"]) == p]
         sel.append(sel[0])  # close the loop
-        for ax, (x, y) in zip(axes, [("x_m", "tx_n"), ("y_m", "ty_n"), ("z_m", "n_n")]):
-            ax.plot([float(r[x]) for r in sel], [float(r[y]) for r in sel], lw=1, label=f"pair {p}")
-    for ax, t in zip(axes, ["tangential x", "tangential y", "normal"]):
-        ax.set_title(t)
-        ax.set_xlabel("relative displacement [m]")
+        x = [float(r["x_m"]) for r in sel]
+        y = [float(r["y_m"]) for r in sel]
+        tx = [float(r["tx_n"]) for r in sel]
+        ty = [float(r["ty_n"]) for r in sel]
+        ex, ey = main_direction(tx[:-1], ty[:-1])
+        u = [(a * ex + b * ey) / du for a, b in zip(x, y)]
+        f = [(a * ex + b * ey) / fu for a, b in zip(tx, ty)]
+        axes[0].plot(u, f, lw=1.2, label=f"pair {p}")
+        axes[1].plot([a / du for a in x], [b / du for b in y], lw=1.2)
+        axes[2].plot([float(r["z_m"]) / du for r in sel], [float(r["n_n"]) / fu for r in sel], lw=1.2)
+    axes[0].set_title("tangential loop (along the force's main direction)")
+    axes[0].set_xlabel(f"relative displacement [{dlabel}]")
+    axes[0].set_ylabel(f"tangential force [{flabel}]")
+    axes[1].set_title("relative tangential motion (orbit)")
+    axes[1].set_xlabel(f"x [{dlabel}]")
+    axes[1].set_ylabel(f"y [{dlabel}]")
+    axes[1].set_aspect("equal", adjustable="datalim")
+    if not any(col["n_n"]) and not any(col["z_m"]):
+        axes[2].text(0.5, 0.5, "no normal motion or load in loops.csv\n(1d contact: constant normal load)",
+                     ha="center", va="center", transform=axes[2].transAxes, fontsize=9, color="0.3")
+    axes[2].set_title("normal loop")
+    axes[2].set_xlabel(f"normal displacement (+ closes) [{dlabel}]")
+    axes[2].set_ylabel(f"normal force (+ presses) [{flabel}]")
+    for ax in axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            fmt = ScalarFormatter(useOffset=False)
+            fmt.set_scientific(False)
+            axis.set_major_formatter(fmt)
+        ax.locator_params(nbins=6)
         ax.grid(True, alpha=0.3)
-    axes[0].set_ylabel("contact force [N]")
+    more = f" ({len(shown)} of {len(pairs)} pairs)" if len(shown) < len(pairs) else ""
     axes[0].legend(fontsize=7)
-    fig.suptitle("contact loops at the peak")
+    fig.suptitle(f"{result_name(result_dir)}: contact loops at the peak{more}")
     fig.tight_layout()
     fig.savefig(os.path.join(result_dir, "loops.png"), dpi=110)
     plt.close(fig)
