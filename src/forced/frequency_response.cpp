@@ -269,7 +269,49 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
       for (const auto& p : second.points)
         reached_back = direction > 0 ? std::min(reached_back, p.lambda) : std::max(reached_back, p.lambda);
       const bool covered = direction * (reached_back - reached) <= 0;
-      if (second.status == continuation::BranchStatus::kLeftRange && covered) {
+      // Neither piece got through: a third start in the middle of the gap between where they
+      // stopped, traced both ways into them (pieces 2 and 3). The range is covered when both
+      // reach the far side of the gap; they are one curve with the others only if each ends
+      // on the piece it runs into (the same join test as above).
+      std::vector<continuation::Branch> middle;
+      std::string middle_message;
+      if (!covered && second.status != continuation::BranchStatus::kReachedEnd) {
+        const double lo = reached, hi = reached_back;  // the gap, in the direction of travel
+        const double f_mid = 0.5 * (lo + hi);
+        say(info, "frf: the pieces stopped at " + shortest(lo) + " and " + shortest(hi) +
+                      " Hz; tracing both ways from " + shortest(f_mid) + " Hz");
+        try {
+          std::string how_mid;
+          const Eigen::VectorXd mid_start = find_start_logged(model, eo, equations, ao, f_mid, how_mid, info);
+          const int left = ao.max_points - static_cast<int>(first.points.size() + second.points.size());
+          for (int k = 0; k < 2 && left > 2; ++k) {
+            continuation::ArclengthOptions mo = ao;
+            mo.lambda_start = f_mid;
+            mo.lambda_end = k == 0 ? hi + direction * overlap : lo - direction * overlap;
+            mo.max_points = std::max(1, left / 2);
+            middle.push_back(continuation::trace(equations, mid_start, mo));
+            add_counts(out.summary, middle.back());
+          }
+          if (middle.size() < 2) middle_message = "no points left for the middle of the gap";
+        } catch (const NumericalError& e) {
+          middle_message = std::string("no start point in the middle of the gap either: ") + e.what();
+        }
+      }
+      const bool middle_covers = middle.size() == 2 && middle[0].status == continuation::BranchStatus::kReachedEnd &&
+                                 middle[1].status == continuation::BranchStatus::kReachedEnd;
+      if (middle_covers) {
+        const double d_second = continuation::distance_to_branch(equations, ao, second.points, middle[0].points.back());
+        const double d_first = continuation::distance_to_branch(equations, ao, first.points, middle[1].points.back());
+        out.join_distance = std::max(d_first, d_second);
+        out.pieces_join = out.join_distance <= kJoinTolerance;
+        covered_with(std::string("the curve is in four pieces") +
+                     (out.pieces_join ? " that join" : ", not all shown to be one branch") + ": from " +
+                     shortest(ao.lambda_start) + " Hz to " + shortest(reached) + " Hz (" + first_message +
+                     "), back from " + shortest(ao.lambda_end) + " Hz to " + shortest(reached_back) + " Hz (" +
+                     second.message + "), and both ways from " + shortest(0.5 * (reached + reached_back)) +
+                     " Hz into them (largest join distance " + shortest(out.join_distance) +
+                     "; frf.csv column `piece`)");
+      } else if (second.status == continuation::BranchStatus::kLeftRange && covered) {
         // Both pieces turned back, but between them every frequency of the range has a
         // solution: reported as two separate branches.
         out.pieces_join = false;
@@ -283,6 +325,14 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
         out.pieces_join = false;
         out.summary.message =
             first_message + "; tracing back from " + shortest(ao.lambda_end) + " Hz stopped too: " + second.message;
+        if (!middle.empty() || !middle_message.empty()) {
+          std::string m = middle_message;
+          for (std::size_t k = 0; k < middle.size(); ++k)
+            if (middle[k].status != continuation::BranchStatus::kReachedEnd)
+              m += (m.empty() ? "" : "; ") + std::string(k == 0 ? "forward" : "backward") +
+                   " from the middle of the gap: " + middle[k].message;
+          out.summary.message += "; " + m;
+        }
       } else {
         out.join_distance = continuation::distance_to_branch(equations, ao, first.points, second.points.back());
         // Two solutions of the same equations to tolerance agree far within a step.
@@ -307,6 +357,12 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
         out.piece.push_back(1);
         if (progress) progress(p, 1);
       }
+      for (std::size_t k = 0; k < middle.size(); ++k)
+        for (const auto& p : middle[k].points) {
+          out.points.push_back(p);
+          out.piece.push_back(2 + static_cast<int>(k));
+          if (progress) progress(p, 2 + static_cast<int>(k));
+        }
     } catch (const NumericalError& e) {
       out.summary.message = first_message + "; no start point at the end of the range either: " + e.what();
     }
@@ -338,7 +394,8 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
 
   // Resonance peaks, located along the branch.
   const auto t0 = std::chrono::steady_clock::now();
-  for (int pc = 0; pc <= 1; ++pc) {
+  const int n_pieces = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
+  for (int pc = 0; pc < n_pieces; ++pc) {
     std::vector<std::size_t> idx;
     std::vector<double> amp;
     for (std::size_t i = 0; i < out.points.size(); ++i)

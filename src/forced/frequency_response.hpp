@@ -78,12 +78,12 @@ struct ResponsePeak {
 
 struct FrequencyResponse {
   std::vector<continuation::BranchPoint> points;  ///< every point, piece after piece
-  std::vector<int> piece;                         ///< of each point (0, or 1 traced back from the end)
-  std::vector<PointResult> results;               ///< analyse() of each point
-  std::vector<ResponsePeak> peaks;                ///< by frequency
-  continuation::Branch summary;                   ///< status, message and counts of all pieces (no points)
-  continuation::ArclengthOptions options;         ///< as traced (units included)
-  std::string start, start_second_piece;          ///< how the start points were found
+  std::vector<int> piece;  ///< of each point: 0, 1 traced back from the end, 2 and 3 both ways from a gap's middle
+  std::vector<PointResult> results;        ///< analyse() of each point
+  std::vector<ResponsePeak> peaks;         ///< by frequency
+  continuation::Branch summary;            ///< status, message and counts of all pieces (no points)
+  continuation::ArclengthOptions options;  ///< as traced (units included)
+  std::string start, start_second_piece;   ///< how the start points were found
   bool two_pieces = false;
   bool pieces_join = true;
   double join_distance = 0.0;  ///< scaled distance at the join check

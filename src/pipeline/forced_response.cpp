@@ -158,23 +158,26 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   // from the end), the point rate and the time left at that rate; with --verbose a line per
   // point instead.
   const double f0 = c.continuation.frequency_start_hz, f1 = c.continuation.frequency_end_hz;
-  double covered[2] = {0.0, 0.0};
+  double covered[2] = {0.0, 0.0};  // by the pieces from the start and from the end
   const log::Stopwatch trace_clock;
   auto progress = [&](const continuation::BranchPoint& p, int piece) {
     ++reported;
     std::ostringstream s;
     if (log::detailed()) {
-      s << "frf: point " << reported << (piece ? " (piece 2)" : "") << "  f = " << std::setprecision(7) << p.lambda
-        << " Hz  step " << std::setprecision(3) << p.step << "  newton " << p.newton_iterations;
+      s << "frf: point " << reported << (piece ? " (piece " + std::to_string(piece + 1) + ")" : "")
+        << "  f = " << std::setprecision(7) << p.lambda << " Hz  step " << std::setprecision(3) << p.step << "  newton "
+        << p.newton_iterations;
       log::info(s.str());
       return;
     }
-    const double share = (piece == 0 ? p.lambda - f0 : f1 - p.lambda) / (f1 - f0);
-    covered[piece] = std::clamp(std::max(covered[piece], share), 0.0, 1.0);
+    if (piece <= 1) {
+      const double share = (piece == 0 ? p.lambda - f0 : f1 - p.lambda) / (f1 - f0);
+      covered[piece] = std::clamp(std::max(covered[piece], share), 0.0, 1.0);
+    }
     const double done = std::min(1.0, covered[0] + covered[1]), seconds = trace_clock.seconds();
-    s << "frf: " << reported << " points, " << std::setprecision(6) << p.lambda << " Hz" << (piece ? " (piece 2)" : "")
-      << ", " << std::setprecision(3) << 100.0 * done << " % of the range, " << std::setprecision(3)
-      << reported / std::max(seconds, 1e-9) << " points/s";
+    s << "frf: " << reported << " points, " << std::setprecision(6) << p.lambda << " Hz"
+      << (piece ? " (piece " + std::to_string(piece + 1) + ")" : "") << ", " << std::setprecision(3) << 100.0 * done
+      << " % of the range, " << std::setprecision(3) << reported / std::max(seconds, 1e-9) << " points/s";
     if (done > 0.02 && done < 1.0)
       s << ", about " << std::setprecision(2) << seconds * (1.0 - done) / done << " s left";
     log::progress(s.str());

@@ -194,5 +194,70 @@ frequency_end_hz = 1.006079560439476)");
   EXPECT_GT(frf["kinks_crossed"].get<int>(), 0);
 }
 
+TEST(CliContinuation, AGapBothPiecesLeaveIsCoveredFromItsMiddleAndReportedHonestly) {
+  // Stress corpus model 105 (quasi3d, N = 64): the branch from 545 Hz closes on itself near
+  // 778 Hz, the one traced back from 1392 Hz near 1004 Hz; between them no piece got through
+  // and the run used to stop (exit 3). A start in the middle of the gap, traced both ways,
+  // covers it: exit 0, four pieces in frf.csv, and since the middle pieces do not end on the
+  // pieces they run into, a warning that they are not all shown to be one branch.
+  const Scratch s("gap_middle");
+  s.write("case.toml", R"(name = "stress_0105"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[20.527841424563977, 0.0, 0.0, 0.0], [0.0, 104.54819099206871, 0.0, 0.0], [0.0, 0.0, 87.97837496433017, 0.0], [0.0, 0.0, 0.0, 119.01449762240684]]
+stiffness = [[4268575626.744325, 196050792.3089846, -1600439918.6397486, -996650982.536285], [196050792.3089846, 5899021123.720413, -1636841536.2168021, -3729562681.3690977], [-1600439918.6397486, -1636841536.2168021, 3402412039.4073896, 1061079982.3023541], [-996650982.536285, -3729562681.3690977, 1061079982.3023541, 8950267825.224955]]
+damping = [[116.30663967447224, 4.038083160984023, -32.964465022106594, -20.528147336507942], [4.038083160984023, 266.07388172002027, -33.71423377967842, -76.81827797836853], [-32.964465022106594, -33.71423377967842, 191.7378866934617, 21.855199657849077], [-20.528147336507942, -76.81827797836853, 21.855199657849077, 348.9250503828979]]
+
+[excitation]
+force = 0.008188408188264853
+dof = 1
+
+[response]
+dof = 2
+
+[contact]
+model = "quasi3d"
+friction_coefficient = 0.19079267070287287
+tangential_stiffness = 150483167.26757142
+normal_stiffness = 7150255545.2713
+normal_preload = 9.762483354157716
+frame_angle_deg = 0.0
+
+[[contact.elements]]
+x_dof = 3
+y_dof = 1
+z_dof = 0
+
+[hbm]
+harmonics = 4
+time_samples = 64
+
+[continuation]
+frequency_start_hz = 545.0431703885854
+frequency_end_hz = 1391.629964680137)");
+  const CliResult r = s.run("frf case.toml --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto frf = frf_of(s, "results/stress_0105");
+  EXPECT_EQ(frf["pieces"].get<int>(), 4);
+  EXPECT_TRUE(frf.contains("pieces_join"));
+  EXPECT_FALSE(frf["pieces_join"].get<bool>());
+  EXPECT_NE(r.err.find("four pieces, not all shown to be one branch"), std::string::npos) << r.err;
+  EXPECT_TRUE(frf["energy_check_passed"].get<bool>());
+  // Every piece's points lie inside the range, and between them they cover it.
+  const auto rows = csv_rows(slurp(s.dir() / "results" / "stress_0105" / "frf.csv"));
+  const double f0 = 545.0431703885854, f1 = 1391.629964680137;
+  std::vector<double> f;
+  for (std::size_t i = 1; i < rows.size(); ++i) f.push_back(std::stod(rows[i][0]));
+  std::sort(f.begin(), f.end());
+  ASSERT_FALSE(f.empty());
+  EXPECT_NEAR(f.front(), f0, 1e-9 * f0);
+  EXPECT_NEAR(f.back(), f1, 1e-9 * f1);
+  double widest = 0.0;
+  for (std::size_t i = 1; i < f.size(); ++i) widest = std::max(widest, f[i] - f[i - 1]);
+  EXPECT_LT(widest, 0.01 * (f1 - f0));  // no stretch of the range left without points
+}
+
 }  // namespace
 }  // namespace shroudsim::testing
