@@ -7,7 +7,8 @@ usage: tools/bench_modal_ccx.py [--case CASE] [--sizes S ...] [--modes M] [--thr
 For each mesh size: the sector is meshed once by `shroudsim mesh` (gmsh, 10-node tets), then
 timed, each with T solver threads:
   - `shroudsim modes CASE` (assembly, cyclic reduction, M modes of every harmonic index,
-    modes.csv, modes.vtu, the plot), from the cached mesh with an empty modal cache;
+    modes.csv, modes.vtu, the plot), from the mesh just made, with an empty modal cache (the
+    case is copied into the work folder, whose `.cache` starts empty);
   - `ccx` (CalculiX) on the same mesh: C3D10 elements, the hub clamped, the cyclic faces tied
     by *TIE, CYCLIC SYMMETRY and *CYCLIC SYMMETRY MODEL (N = Nb, axis z), *FREQUENCY 2 M (CalculiX
     counts each cyclic mode twice, as its two real forms),
@@ -151,15 +152,24 @@ def main(argv):
         work = os.path.join(a.work, f"h{size:g}")
         shutil.rmtree(work, ignore_errors=True)
         os.makedirs(work)
+        # The case is copied into the work folder: the modal cache lives beside the case file
+        # (`.cache`), and a cached stage would time a lookup instead of the modal solve.
+        local_case = os.path.join(work, os.path.basename(case))
+        shutil.copy(case, local_case)
         sets = ["--set", f"geometry.mesh_size={size}", "--set", f"modal.modes={a.modes}",
                 "--set", 'modal.harmonic_indices="all"']
         common = ["--quiet", "--threads", str(a.threads)]
-        subprocess.run([binary, "mesh", case, "--out", os.path.join(work, "mesh")] + sets + common, cwd=work,
+        subprocess.run([binary, "mesh", local_case, "--out", os.path.join(work, "mesh")] + sets + common, cwd=work,
                        check=True)
         t0 = time.perf_counter()
-        subprocess.run([binary, "modes", case, "--out", os.path.join(work, "modes")] + sets + common, cwd=work,
+        subprocess.run([binary, "modes", local_case, "--out", os.path.join(work, "modes")] + sets + common, cwd=work,
                        check=True)
         t_ours = time.perf_counter() - t0
+        with open(os.path.join(work, "modes", "run.json")) as f:
+            import json
+            if any(st["name"] == "modes" and st["reused"] for st in json.load(f)["stages"]):
+                print(f"bench_modal_ccx: the modal stage was reused from a cache at {size}", file=sys.stderr)
+                return 1
         msh = os.path.join(work, "meshes", f"{name}.msh")
         if not os.path.exists(msh):
             found = [f for f in os.listdir(os.path.join(work, "meshes")) if f.endswith(".msh")]
