@@ -19,7 +19,6 @@
 #include "io/output.hpp"
 #include "io/results_folder.hpp"
 #include "io/schema.hpp"
-#include "linalg/blas.hpp"
 
 namespace shroudsim::app {
 namespace {
@@ -203,11 +202,6 @@ int run_cli(int argc, char** argv) {
   }
   ctx.out_dir = folder->staging();
   ctx.threads = o.threads;
-  // --threads bounds the BLAS too: OpenBLAS otherwise starts a thread per core, and on a
-  // loaded machine its waiting threads spin on cores other processes need (`modes` of a
-  // 19k-DOF sector with --threads 1 beside two busy processes: 45.6 s, 10.4 s with one BLAS
-  // thread; BENCHMARKS.md).
-  if (o.threads > 0) linalg::set_blas_threads(o.threads);
   ctx.overrides = o.sets;
   ctx.convergence = o.convergence;
   const std::string command = subs[chosen].name;
