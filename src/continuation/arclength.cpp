@@ -77,7 +77,7 @@ void check_options(const ParametricResidual& residual, const Eigen::VectorXd& x,
                                 ", the residual " + std::to_string(residual.size()));
 }
 
-// Is the newest point (y, tangent t, reached by a step h) a point passed before, more than
+// Is the newest point (the last of ys and points, reached by a step h) a point passed before, more than
 // kLoopGap points back, travelling the same way? A candidate lies within a twentieth of the
 // chord of an earlier step (a smooth branch is that close to its chords) with both tangents
 // along t; it is confirmed by the corrector from that step's first point onto the hyperplane
@@ -85,13 +85,15 @@ void check_options(const ParametricResidual& residual, const Eigen::VectorXd& x,
 // corrector's tolerance. A twin a sample away (the far side of a Z at a corner of a sampled
 // law, running alongside at the slab's width) stays at its own distance.
 bool closes_loop(ParametricResidual& residual, const ArclengthOptions& o, const std::vector<Eigen::VectorXd>& ys,
-                 const std::vector<BranchPoint>& points, const Eigen::VectorXd& y, const Eigen::VectorXd& t, double h) {
+                 const std::vector<BranchPoint>& points, double h) {
   constexpr std::size_t kLoopGap = 8;
   constexpr double kChordFraction = 0.05;
   constexpr double kSameWay = 0.99;  // cosine between the tangents
   constexpr double kLoopTolerance = 100.0;
   const std::size_t m = ys.size();
   if (m < kLoopGap + 2) return false;
+  const Eigen::VectorXd& y = ys.back();
+  const Eigen::VectorXd& t = points.back().tangent;
   const int n = static_cast<int>(y.size()) - 1;
   for (std::size_t j = 0; j + kLoopGap + 1 < m; ++j) {
     const Eigen::VectorXd& a = ys[j];
@@ -298,7 +300,7 @@ Branch trace(ParametricResidual& residual, const Eigen::VectorXd& x_guess, const
     y = y_new;
     t = t_new;
     push(y, t, it, h, rnorm, PointKind::kRegular);
-    if (closes_loop(residual, o, ys, branch.points, y, t, h))
+    if (closes_loop(residual, o, ys, branch.points, h))
       return finish(BranchStatus::kClosedLoop,
                     "the branch closed on itself at lambda = " + std::to_string(s.lambda_of(y)) +
                         " (it came back to a point passed before, travelling the same way)");

@@ -128,10 +128,12 @@ bool turn_at_corner(ScaledSystem& s, const Eigen::VectorXd& y, const Eigen::Vect
     const Eigen::VectorXd y_pred = yk + h * v;
     Eigen::VectorXd yc = y_pred;
     const int it = correct(s, yc, v, y_pred, rnorm);
-    if (it < 0 || (yc - y).norm() < 0.5 * h) continue;
-    // Not the piece the branch came along, traced backwards.
+    if (it < 0) continue;
     const Eigen::VectorXd d = yc - y;
-    if ((d - d.dot(t) * t).norm() < 1e-3 * d.norm()) continue;
+    const double moved = d.norm();
+    if (moved < 0.5 * h) continue;
+    // Not the piece the branch came along, traced backwards.
+    if ((d - d.dot(t) * t).norm() < 1e-3 * moved) continue;
     if (!s.tangent(yc, v, v, t_new)) continue;
     y_new = yc;
     iterations = it;

@@ -275,9 +275,9 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
       // on the piece it runs into (the same join test as above).
       std::vector<continuation::Branch> middle;
       std::string middle_message;
+      const double f_mid = 0.5 * (reached + reached_back);
       if (!covered && second.status != continuation::BranchStatus::kReachedEnd) {
         const double lo = reached, hi = reached_back;  // the gap, in the direction of travel
-        const double f_mid = 0.5 * (lo + hi);
         say(info, "frf: the pieces stopped at " + shortest(lo) + " and " + shortest(hi) +
                       " Hz; tracing both ways from " + shortest(f_mid) + " Hz");
         try {
@@ -308,7 +308,7 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
                      (out.pieces_join ? " that join" : ", not all shown to be one branch") + ": from " +
                      shortest(ao.lambda_start) + " Hz to " + shortest(reached) + " Hz (" + first_message +
                      "), back from " + shortest(ao.lambda_end) + " Hz to " + shortest(reached_back) + " Hz (" +
-                     second.message + "), and both ways from " + shortest(0.5 * (reached + reached_back)) +
+                     second.message + "), and both ways from " + shortest(f_mid) +
                      " Hz into them (largest join distance " + shortest(out.join_distance) +
                      "; frf.csv column `piece`)");
       } else if (second.status == continuation::BranchStatus::kLeftRange && covered) {

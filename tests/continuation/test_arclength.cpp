@@ -79,14 +79,19 @@ TEST(Arclength, TracesBothFoldsOfTheDuffingResponse) {
 }
 
 /// x^2 + lambda^2 = 1: from (1, 0) the branch turns at lambda = 1 and comes back to 0.
+/// x^2 + (lambda - centre)^2 = radius^2.
 class Circle : public ParametricResidual {
  public:
+  explicit Circle(double centre = 0.0, double radius = 1.0) : centre_(centre), radius_(radius) {}
   int size() const override { return 1; }
   bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd*) override {
-    r = Eigen::VectorXd::Constant(1, x[0] * x[0] + l * l - 1.0);
+    r = Eigen::VectorXd::Constant(1, x[0] * x[0] + (l - centre_) * (l - centre_) - radius_ * radius_);
     if (J) *J = Eigen::MatrixXd::Constant(1, 1, 2 * x[0]);
     return true;
   }
+
+ private:
+  double centre_, radius_;
 };
 
 TEST(Arclength, PassesATurningPointAndReportsLeavingTheRange) {
@@ -468,20 +473,10 @@ TEST(ArclengthEvents, ACornerThatTurnsTheBranchBackIsFollowedOntoTheOtherPiece) 
   EXPECT_FALSE(turn_at_corner(s, y0, t, 0.01, y_new, t_new, iterations, rnorm));
 }
 
-/// x^2 + (lambda - 0.5)^2 = 0.09: a closed branch (an isola) inside the range once the
-/// branch may go below lambda_start.
-class Isola : public ParametricResidual {
- public:
-  int size() const override { return 1; }
-  bool evaluate(const Eigen::VectorXd& x, double l, Eigen::VectorXd& r, Eigen::MatrixXd* J, Eigen::VectorXd*) override {
-    r = Eigen::VectorXd::Constant(1, x[0] * x[0] + (l - 0.5) * (l - 0.5) - 0.09);
-    if (J) *J = Eigen::MatrixXd::Constant(1, 1, 2 * x[0]);
-    return true;
-  }
-};
-
 TEST(Arclength, AClosedBranchIsReportedOnceItComesBackOntoItself) {
-  Isola isola;
+  // x^2 + (lambda - 0.5)^2 = 0.09: a closed branch (an isola) inside the range once the
+  // branch may go below lambda_start.
+  Circle isola(0.5, 0.3);
   ArclengthOptions o;
   o.lambda_start = 0.3;
   o.lambda_end = 1.0;
