@@ -20,6 +20,7 @@ packages=(
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-meshio python3-matplotlib
+  python3-dev pybind11-dev python3-pybind11
 )
 missing=()
 for p in "${packages[@]}"; do
