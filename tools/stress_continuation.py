@@ -607,6 +607,30 @@ def main():
     print("  reached the end (exit 0): %d of %d (%d of them in two pieces)" % (count("ok"), len(rows), two_pieces))
     print("  bad input (exit 2, generator bugs): %d" % count("bad_input"))
     print("  numerics failed (exit 3): %d" % count("numerics"))
+    # The start search integrates a lumped model in time when the harmonic balance finds no
+    # start: its verdict that no motion of the excitation's period exists is in the message.
+    def verdict(r):
+        m = r.get("message") or ""
+        if r["exit_class"] != "numerics" or "time integration: the motion at" not in m:
+            return None
+        if "nearly periodic" in m:
+            return "nearly"
+        if "but does with H =" in m:
+            return "finer_n"
+        for v in ("subharmonic", "not periodic", "periodic"):
+            if " is " + v in m:
+                return v
+        return None
+    verdicts = [verdict(r) for r in rows]
+    for v, text in (("subharmonic", "subharmonic (repeats every p > 1 periods): no solution of the excitation's "
+                                    "period exists"),
+                    ("not periodic", "not periodic (changes by more than 1e-2 per period): none exists"),
+                    ("nearly", "nearly periodic (changes below 1e-2 per period) but no harmonic-balance "
+                               "solution near it"),
+                    ("periodic", "periodic, but no harmonic-balance solution near it (H, N given, nor N = 1024 "
+                                 "with H or 2H)"),
+                    ("finer_n", "periodic, a harmonic-balance solution near it only with N = 1024 (and 2H)")):
+        print("    time integration at the failing start: %s: %d" % (text, verdicts.count(v)))
     print("  timeout (> %g s): %d" % (args.timeout, count("timeout")))
     print("  other exit: %d" % count("other"))
     print("  points, all runs with run.json: %s; exit 0: %s" % (stats([r.get("points") for r in rows]),

@@ -9,6 +9,8 @@
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "forced/excitation_homotopy.hpp"
+#include "forced/time_march.hpp"
+#include "frf/lumped.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -104,12 +106,81 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   return start;
 }
 
+// Where the harmonic balance finds no start at f, a lumped model is integrated in time from
+// rest (forced/time_march.hpp): a periodic motion gives the start (Newton from its harmonics);
+// a motion that does not repeat every excitation period is the reason, in `why`.
+constexpr int kPatientNewtonIterations = 100;
+constexpr int kFinerTimeSamples = 1024;
+
+bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                           ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
+                           Eigen::VectorXd& x, std::string& how, std::string& why, const Info& info) {
+  const auto* lumped = dynamic_cast<const frf::LumpedLinearPart*>(model.linear.get());
+  if (lumped == nullptr) return false;
+  const LumpedSystem system{lumped->mass(), lumped->damping(), lumped->stiffness(), lumped->contact_operator(),
+                            lumped->force_vector()};
+  TimeMarchOptions to;
+  to.output_samples = eo.n_time_samples;
+  say(info, "frf: no harmonic-balance start at " + shortest(f) + " Hz; integrating the equations of motion in time");
+  const TimeMarchResult tm = march_to_steady_state(system, model.pairs, eo.law.model, f, to);
+  const std::string what = "the motion at " + shortest(f) + " Hz is " + tm.describe();
+  // A motion that still changes by up to a percent from period to period may be periodic to
+  // the scheme's resolution of its stick-slip and impact instants (a step quantizes them): it
+  // is tried as a start too, and only a converged harmonic balance counts.
+  constexpr double kNearlyPeriodic = 1e-2;
+  const bool nearly = tm.motion == TimeMarchResult::Motion::not_settled && tm.change_one_period < kNearlyPeriodic;
+  if (tm.motion != TimeMarchResult::Motion::periodic && !nearly) {
+    why = what;
+    return false;
+  }
+  x = harmonic_unknowns(tm.contact_motion, eo.n_harmonics, contact::n_directions(eo.law.model));
+  // The guess is near the solution but the sampled law's corners make plain Newton cycle:
+  // more iterations (each with its backtracking) than a continuation step gets.
+  continuation::ArclengthOptions patient = ao;
+  patient.max_newton_iterations = std::max(ao.max_newton_iterations, kPatientNewtonIterations);
+  if (continuation::newton_fixed(equations, x, f, patient) >= 0) {
+    how = "time integration (" + std::to_string(tm.periods) + " periods), then Newton";
+    say(info, "frf: start point at " + shortest(f) + " Hz from " + how);
+    return true;
+  }
+  // Which discretization does have a solution there: the same harmonics with a finer sampling
+  // of the period (the sampled law's stick-slip corners are what Newton cycles between), then
+  // twice the harmonics (a truncation that misses the motion's corners).
+  const std::string none =
+      (nearly ? "; taken as nearly periodic, Newton from its last period's harmonics" : "; Newton from its harmonics") +
+      std::string(" does not converge with H = ") + std::to_string(eo.n_harmonics) +
+      ", N = " + std::to_string(eo.n_time_samples);
+  std::string tried;
+  for (const int h : {eo.n_harmonics, 2 * eo.n_harmonics}) {
+    hbm::ContactEvaluatorOptions finer = eo;
+    finer.n_harmonics = h;
+    finer.n_time_samples = std::max(eo.n_time_samples, kFinerTimeSamples);
+    if (2 * h + 1 > tm.contact_motion.cols() || 2 * h + 1 > finer.n_time_samples) continue;
+    if (h == eo.n_harmonics && finer.n_time_samples == eo.n_time_samples) continue;
+    const std::string settings = "H = " + std::to_string(h) + ", N = " + std::to_string(finer.n_time_samples);
+    hbm::ContactEvaluator evaluator(finer, model.pairs);
+    ReducedEquations fine(*model.linear, evaluator);
+    Eigen::VectorXd xf = harmonic_unknowns(tm.contact_motion, h, contact::n_directions(eo.law.model));
+    continuation::ArclengthOptions fo = patient;
+    fo.x_scale = Eigen::VectorXd::Constant(xf.size(), ao.x_scale[0]);
+    if (continuation::newton_fixed(fine, xf, f, fo) >= 0) {
+      why = what + none + " but does with " + settings + ": raise hbm.time_samples" +
+            (h > eo.n_harmonics ? " and hbm.harmonics" : "") +
+            " (the coarser discretization has no solution near this motion)";
+      return false;
+    }
+    tried += (tried.empty() ? "" : ", ") + settings;
+  }
+  why = what + none + (tried.empty() ? "" : " (nor with " + tried + ")");
+  return false;
+}
+
 Eigen::VectorXd find_start_logged(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
                                   ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
                                   std::string& how, const Info& info) {
   try {
     return find_start_at(model, eo, equations, ao, f, how, info);
-  } catch (const NumericalError&) {
+  } catch (const NumericalError& first) {
     // Every start can fail at one frequency and work a little way off it (the excitation
     // homotopy meets a sampled stick-slip corner). Start nearby, then walk to f by Newton at
     // fixed frequencies.
@@ -131,6 +202,10 @@ Eigen::VectorXd find_start_logged(const ForcedModel& model, const hbm::ContactEv
       say(info, "frf: start point at " + shortest(f) + " Hz from " + how);
       return x;
     }
+    Eigen::VectorXd x;
+    std::string why;
+    if (start_from_time_march(model, eo, equations, ao, f, x, how, why, info)) return x;
+    if (!why.empty()) throw NumericalError(std::string(first.what()) + "; time integration: " + why);
     throw;
   }
 }

@@ -36,6 +36,15 @@ class LumpedLinearPart : public LinearPart {
 
   /// B (c x ndof): relative displacement operator of the contacts.
   const Eigen::MatrixXd& contact_operator() const { return b_; }
+  const Eigen::MatrixXd& mass() const { return m_; }
+  const Eigen::MatrixXd& stiffness() const { return k_; }
+  const Eigen::MatrixXd& damping() const { return c_; }
+  /// The excitation's force amplitude on every DOF (f(t) = force_vector() cos(w t)).
+  Eigen::VectorXd force_vector() const {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(m_.rows());
+    f[excited_dof_] = force_;
+    return f;
+  }
 
  private:
   /// Complex displacements of every DOF for harmonic n under contact forces F_n.

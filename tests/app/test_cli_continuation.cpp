@@ -125,6 +125,59 @@ TEST(CliContinuation, ACurveThatFailsItsEnergyCheckIsNotReportedAsSuccess) {
   EXPECT_EQ(good.status, 0) << good.err;
 }
 
+TEST(CliContinuation, WhereNoMotionOfTheExcitationsPeriodExistsTheStopSaysSo) {
+  // A stress-corpus model (tools/stress_continuation.py, seed 1, model 131: 3 DOFs, a full3d
+  // contact without preload, so it impacts; first mode 8.41 Hz) started at 4.27 Hz, about half
+  // of it. No harmonic-balance start is found there, and a time integration from rest
+  // (forced/time_march.hpp) settles on a motion that repeats every two excitation periods: a
+  // subharmonic, which a harmonic balance of the excitation's period cannot represent. The run
+  // stops (exit 3) and says so.
+  const Scratch s("subharmonic");
+  s.write("case.toml", R"(name = "stress_0131"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[18.15501439951414, 0.0, 0.0], [0.0, 42.8550096420159, 0.0], [0.0, 0.0, 10.490537497208551]]
+stiffness = [[370681.8733347799, -186888.25051647378, 0.0], [-186888.25051647378, 319495.4706231562, -132607.2201066824], [0.0, -132607.2201066824, 223491.84451767677]]
+damping = [[266.1261834145856, -94.91376025229103, 0.0], [-94.91376025229103, 346.07344752183434, -67.34639476877648], [0.0, -67.34639476877648, 158.49930917894164]]
+
+[excitation]
+force = 3.498485488581492
+dof = 2
+
+[response]
+dof = 0
+
+[contact]
+model = "full3d"
+friction_coefficient = 0.49809335994186493
+tangential_stiffness = 4453169.612587134
+normal_stiffness = 13937757.214890867
+normal_preload = 0.0
+frame_angle_deg = 15.335515728693025
+
+[[contact.elements]]
+x_dof = 2
+y_dof = 0
+z_dof = 1
+
+[hbm]
+harmonics = 12
+time_samples = 128
+
+[continuation]
+frequency_start_hz = 4.269022959253111
+frequency_end_hz = 12.316202486923972
+)");
+  const CliResult r = s.run("frf case.toml --quiet --out out");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("no solution at the start frequency"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("subharmonic (repeats every 2 excitation periods"), std::string::npos) << r.err;
+  const auto run = nlohmann::json::parse(slurp(s.dir() / "out" / "run.json"));
+  EXPECT_NE(run.dump().find("subharmonic"), std::string::npos);
+}
+
 TEST(CliContinuation, WithoutAResonanceInTheRangeThePeakIsTheLargestPoint) {
   // The Jenkins oscillator above its 10 Hz resonance, 12 to 20 Hz: the amplitude falls all
   // the way, so there is no interior peak to locate; the reported one is the largest point

@@ -1,0 +1,192 @@
+// The time integration of lumped models (forced/time_march.hpp) against closed forms (the
+// linear response, exactly subharmonic and quasi-periodic undamped motions), and the harmonic
+// balance against it (Jenkins element; full-3D contact that separates over part of the period).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+
+#include "continuation/arclength.hpp"
+#include "forced/reduced_equations.hpp"
+#include "forced/time_march.hpp"
+#include "frf/lumped.hpp"
+#include "hbm/contact_evaluator.hpp"
+#include "hbm/harmonic_layout.hpp"
+
+namespace shroudsim::forced {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using Motion = TimeMarchResult::Motion;
+
+// The scheme's relative error at 4096 steps per period is O((w dt)^2) ~ 2e-6 on the motion's
+// amplitude near the modes used here (Newmark's period error (w dt)^2 / 12, amplified by at
+// most ~5 by the resonance 30 % away): 2e-5 bounds it with margin.
+constexpr double kSchemeError = 2e-5;
+
+LumpedSystem system_of(const frf::LumpedLinearPart& p) {
+  return {p.mass(), p.damping(), p.stiffness(), p.contact_operator(), p.force_vector()};
+}
+
+contact::PairParameters pair(double kt, double kn, double mu, double n0) {
+  contact::PairParameters p;
+  p.tangential_stiffness = kt;
+  p.normal_stiffness = kn;
+  p.friction_coefficient = mu;
+  p.normal_preload = n0;
+  return p;
+}
+
+/// A 3-DOF chain (masses 1, 2, 1.5 kg; springs 4e4, 3e4, 2e4 N/m; C = 1e-3 K), a 1d element on
+/// DOF 2 (to ground), unit force on DOF 0.
+frf::LumpedLinearPart chain(double damping_factor = 1e-3) {
+  Eigen::MatrixXd m = Eigen::Vector3d(1.0, 2.0, 1.5).asDiagonal(), k(3, 3);
+  k << 7e4, -3e4, 0, -3e4, 5e4, -2e4, 0, -2e4, 2e4;
+  frf::LumpedContact e;
+  e.dof = {2, -1, -1};
+  return frf::LumpedLinearPart(m, k, damping_factor * k, {e}, 0, 1.0, 0);
+}
+
+TEST(TimeMarch, WithoutFrictionTheMotionIsTheExactLinearResponse) {
+  const frf::LumpedLinearPart linear = chain();
+  const std::vector<contact::PairParameters> pairs{pair(1e4, 1.0, 0.0, 1.0)};  // mu = 0: no force
+  for (double f_hz : {3.0, 30.0}) {  // below the first mode (~14 Hz) and between modes 2 and 3
+    TimeMarchOptions o;
+    o.output_samples = 64;
+    const TimeMarchResult r = march_to_steady_state(system_of(linear), pairs, contact::Model::one_d, f_hz, o);
+    ASSERT_EQ(r.motion, Motion::periodic) << r.describe();
+    const Eigen::VectorXd x = harmonic_unknowns(r.contact_motion, 1, 1);
+    const double w = kTwoPi * f_hz;
+    const Eigen::MatrixXcd dyn = linear.stiffness().cast<std::complex<double>>() -
+                                 w * w * linear.mass().cast<std::complex<double>>() +
+                                 std::complex<double>(0, w) * linear.damping().cast<std::complex<double>>();
+    const std::complex<double> exact = dyn.partialPivLu().solve(linear.force_vector().cast<std::complex<double>>())[2];
+    const std::complex<double> marched(x[1], -x[2]);  // U_1 = c1 - i s1
+    EXPECT_LT(std::abs(marched - exact), kSchemeError * std::abs(exact)) << f_hz << " Hz";
+    EXPECT_LT(std::abs(x[0]), kSchemeError * std::abs(exact));
+  }
+}
+
+TEST(TimeMarch, AnUndampedModeAtAFractionOfTheExcitationGivesASubharmonicMotion) {
+  // m u'' + k u = cos(w t) from rest: u = A (cos w t - cos w_n t), periodic over p excitation
+  // periods when w_n = w / p, never periodic when w / w_n is irrational. The scheme (central
+  // differences, 4096 steps per period here) turns a mode w into 2 asin(w dt / 2) / dt, so k
+  // is chosen to give the discrete motion the mode w / p exactly.
+  const std::vector<contact::PairParameters> pairs{pair(1.0, 1.0, 0.0, 1.0)};
+  TimeMarchOptions o;
+  o.max_periods = 600;
+  // Round-off accumulates in an undamped recurrence over ~1e6 steps (~1e-10 of the motion).
+  o.periodicity_tolerance = 1e-8;
+  const auto oscillator = [](double w_n) {
+    frf::LumpedContact e;
+    e.dof = {0, -1, -1};
+    return frf::LumpedLinearPart(Eigen::MatrixXd::Constant(1, 1, 1.0), Eigen::MatrixXd::Constant(1, 1, w_n * w_n),
+                                 Eigen::MatrixXd::Zero(1, 1), {e}, 0, 1.0, 0);
+  };
+  for (int p : {2, 3}) {
+    const double f = 10.0 * p, dt = 1.0 / f / o.min_steps_per_period;
+    const double w_discrete = kTwoPi * f / p, w_n = 2.0 / dt * std::sin(w_discrete * dt / 2.0);
+    const TimeMarchResult r = march_to_steady_state(system_of(oscillator(w_n)), pairs, contact::Model::one_d, f, o);
+    EXPECT_EQ(r.motion, Motion::subharmonic) << r.describe();
+    EXPECT_EQ(r.period_multiple, p) << r.describe();
+  }
+  const TimeMarchResult r = march_to_steady_state(system_of(oscillator(kTwoPi * 10.0)), pairs, contact::Model::one_d,
+                                                  10.0 * std::sqrt(2.0), o);
+  EXPECT_EQ(r.motion, Motion::not_settled) << r.describe();
+  EXPECT_EQ(r.periods, o.max_periods);
+  EXPECT_GT(r.mismatch, 1e-3);
+}
+
+/// The harmonic balance (H, N) from the marched motion's harmonics: Newton converges, and the
+/// solution's harmonics equal the marched ones within `tolerance` of the largest.
+void expect_harmonic_balance_agrees(const frf::LumpedLinearPart& linear,
+                                    const std::vector<contact::PairParameters>& pairs, contact::Model model,
+                                    double f_hz, int h, int n, double tolerance) {
+  TimeMarchOptions o;
+  o.output_samples = n;
+  const TimeMarchResult r = march_to_steady_state(system_of(linear), pairs, model, f_hz, o);
+  ASSERT_EQ(r.motion, Motion::periodic) << r.describe();
+  hbm::ContactEvaluatorOptions eo;
+  eo.n_harmonics = h;
+  eo.n_time_samples = n;
+  eo.law.model = model;
+  hbm::ContactEvaluator evaluator(eo, pairs);
+  ReducedEquations equations(linear, evaluator);
+  const Eigen::VectorXd marched = harmonic_unknowns(r.contact_motion, h, contact::n_directions(model));
+  Eigen::VectorXd x = marched;
+  continuation::ArclengthOptions ao;
+  ao.x_scale = Eigen::VectorXd::Constant(x.size(), marched.lpNorm<Eigen::Infinity>());
+  ao.tolerance = 1e-10;
+  ASSERT_GE(continuation::newton_fixed(equations, x, f_hz, ao), 0);
+  EXPECT_LT((x - marched).lpNorm<Eigen::Infinity>(), tolerance * marched.lpNorm<Eigen::Infinity>());
+}
+
+TEST(TimeMarch, HarmonicBalanceOfAJenkinsElementAgreesWithTheMarchedMotion) {
+  // The 3-DOF chain with a Jenkins element (kt = 1e4 N/m, mu N0 = 0.3 N) in slip over part of
+  // the period near its first mode. The two differ by the harmonic balance's truncation
+  // (H = 15) and sampling (N = 1024) of the stick-slip corners and by the scheme's step error:
+  // measured 1.8e-6 of the largest coefficient; 2e-5 leaves a factor 10.
+  constexpr double kHarmonicBalanceError = 2e-5;
+  const frf::LumpedLinearPart linear = chain(2e-3);
+  expect_harmonic_balance_agrees(linear, {pair(1e4, 1.0, 0.3, 1.0)}, contact::Model::one_d, 13.0, 15, 1024,
+                                 kHarmonicBalanceError);
+}
+
+TEST(TimeMarch, HarmonicBalanceOfAFullThreeDimensionalContactThatSeparatesAgreesWithTheMarchedMotion) {
+  // A mass with x, y, z DOFs (10 Hz, 12 Hz, 25 Hz), coupled in x and z, pressed with 0.5 N on
+  // a full-3D contact (kt = kn = 2e4 N/m, mu = 0.4) and forced in x: the normal motion opens
+  // the contact over part of the period. H = 20, N = 2048: measured 6.0e-6 of the largest
+  // coefficient (the separation instant is sampled, a first-order error in N: docs/physics.md
+  // section 4); 5e-5 leaves a factor 8.
+  constexpr double kHarmonicBalanceError = 5e-5;
+  Eigen::MatrixXd k =
+      Eigen::Vector3d(std::pow(kTwoPi * 10, 2), std::pow(kTwoPi * 12, 2), std::pow(kTwoPi * 25, 2)).asDiagonal();
+  k(0, 2) = k(2, 0) = 0.5 * std::sqrt(k(0, 0) * k(2, 2));
+  frf::LumpedContact e;
+  e.dof = {0, 1, 2};
+  const frf::LumpedLinearPart linear(Eigen::Matrix3d::Identity(), k, 1e-3 * k, {e}, 0, 3.0, 0);
+  TimeMarchOptions o;
+  const std::vector<contact::PairParameters> pairs{pair(2e4, 2e4, 0.4, 0.5)};
+  const TimeMarchResult r = march_to_steady_state(system_of(linear), pairs, contact::Model::full3d, 11.0, o);
+  ASSERT_EQ(r.motion, Motion::periodic) << r.describe();
+  // It does separate: the normal load max(0, N0 + kn z) is zero at some samples.
+  EXPECT_LT(r.contact_motion.row(2).minCoeff(), -0.5 / 2e4);
+  EXPECT_GT(r.contact_motion.row(2).maxCoeff(), -0.5 / 2e4);
+  expect_harmonic_balance_agrees(linear, pairs, contact::Model::full3d, 11.0, 20, 2048, kHarmonicBalanceError);
+  expect_harmonic_balance_agrees(linear, pairs, contact::Model::quasi3d, 11.0, 20, 2048, kHarmonicBalanceError);
+}
+
+TEST(TimeMarch, HarmonicUnknownsFollowTheEvaluatorLayout) {
+  // x(t) = 1 + 2 cos(t) - 3 sin(2 t) in direction y of the second element.
+  const int m = 16;
+  Eigen::MatrixXd samples = Eigen::MatrixXd::Zero(6, m);
+  for (int j = 0; j < m; ++j) {
+    const double t = kTwoPi * j / m;
+    samples(4, j) = 1 + 2 * std::cos(t) - 3 * std::sin(2 * t);
+  }
+  const Eigen::VectorXd x = harmonic_unknowns(samples, 2, 3);
+  const hbm::HarmonicLayout layout(2, 3);
+  ASSERT_EQ(x.size(), 2 * layout.size());
+  const double* y = x.data() + layout.size();
+  EXPECT_NEAR(y[layout.index(1, 0)], 1.0, 1e-14);
+  EXPECT_NEAR(y[layout.index(1, 1, hbm::HarmonicLayout::Part::cosine)], 2.0, 1e-14);
+  EXPECT_NEAR(y[layout.index(1, 2, hbm::HarmonicLayout::Part::sine)], -3.0, 1e-14);
+  EXPECT_NEAR(x.norm(), std::sqrt(14.0), 1e-13);
+}
+
+TEST(TimeMarch, RejectsInconsistentInput) {
+  const frf::LumpedLinearPart linear = chain();
+  LumpedSystem s = system_of(linear);
+  TimeMarchOptions o;
+  EXPECT_THROW(march_to_steady_state(s, {}, contact::Model::one_d, 10.0, o), std::invalid_argument);
+  EXPECT_THROW(march_to_steady_state(s, {pair(1, 1, 0.1, 1)}, contact::Model::one_d, 0.0, o), std::invalid_argument);
+  o.steps_per_stiff_period = 2.0;
+  EXPECT_THROW(march_to_steady_state(s, {pair(1, 1, 0.1, 1)}, contact::Model::one_d, 10.0, o), std::invalid_argument);
+  s.mass(0, 0) = -1.0;
+  const TimeMarchResult r = march_to_steady_state(s, {pair(1, 1, 0.1, 1)}, contact::Model::one_d, 10.0, {});
+  EXPECT_EQ(r.motion, Motion::not_applicable);
+}
+
+}  // namespace
+}  // namespace shroudsim::forced
