@@ -54,19 +54,7 @@ std::string now_utc() {
 /// Writes run.json: the case as run, versions, stages, statistics, status.
 void write_run_json(const Context& ctx, const std::string& command, const std::string& status,
                     const std::string& message) {
-  nlohmann::json j = ctx.report.json();
-  j["command"] = command;
-  j["status"] = status;
-  if (!message.empty()) j["message"] = message;
-  j["case_file"] = ctx.config.file.string();
-  j["case"] = nlohmann::json::parse(ctx.config.resolved_json);
-  j["finished_utc"] = now_utc();
-  j["total_seconds"] = ctx.report.total_seconds();
-  j["peak_memory_mib"] = log::peak_memory_mib();
-  j["versions"] = {{"shroudsim", SHROUDSIM_VERSION},
-                   {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
-                                 std::to_string(EIGEN_MINOR_VERSION)},
-                   {"compiler", __VERSION__}};
+  const nlohmann::json j = run_report(ctx, command, status, message);
   io::write_file_atomic(ctx.out_dir / "run.json", j.dump(2) + "\n");
 }
 
@@ -106,6 +94,24 @@ void print_summary(const Context& ctx, const std::string& command, double second
 }
 
 }  // namespace
+
+nlohmann::json run_report(const Context& ctx, const std::string& command, const std::string& status,
+                          const std::string& message) {
+  nlohmann::json j = ctx.report.json();
+  j["command"] = command;
+  j["status"] = status;
+  if (!message.empty()) j["message"] = message;
+  j["case_file"] = ctx.config.file.string();
+  j["case"] = nlohmann::json::parse(ctx.config.resolved_json);
+  j["finished_utc"] = now_utc();
+  j["total_seconds"] = ctx.report.total_seconds();
+  j["peak_memory_mib"] = log::peak_memory_mib();
+  j["versions"] = {{"shroudsim", SHROUDSIM_VERSION},
+                   {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
+                                 std::to_string(EIGEN_MINOR_VERSION)},
+                   {"compiler", __VERSION__}};
+  return j;
+}
 
 int run_cli(int argc, char** argv) {
   CLI::App app{"shroudsim: friction damping of shrouded bladed disks (cyclic FE + multiharmonic balance)"};

@@ -2,6 +2,9 @@
 // The subcommands: each maps the case onto pipeline stages and library calls and writes its
 // result files. They are written against the pipeline library (src/pipeline), whose names
 // they use unqualified.
+#include <nlohmann/json.hpp>
+#include <string>
+
 #include "pipeline/context.hpp"
 #include "pipeline/forced_model.hpp"
 #include "pipeline/modal_stage.hpp"
@@ -21,6 +24,11 @@ int cmd_static(Context& ctx);
 int cmd_study(Context& ctx);
 /// Every stage the case asks for, in order.
 int cmd_run(Context& ctx);
+
+/// run.json of a finished command (docs/contract.md): the stage report, command, status and
+/// message, the case as run, time, memory and versions.
+nlohmann::json run_report(const Context& ctx, const std::string& command, const std::string& status,
+                          const std::string& message);
 
 /// Runs tools/plot.py on the result folder when /usr/bin/python3 has matplotlib; otherwise
 /// says that plots are skipped. A plotting failure is a warning, not an error.

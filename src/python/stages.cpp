@@ -4,12 +4,9 @@
 #include <stdlib.h>
 
 #include <Eigen/Core>
-#include <chrono>
 #include <complex>
-#include <ctime>
 #include <exception>
 #include <functional>
-#include <iomanip>
 #include <memory>
 #include <sstream>
 
@@ -80,29 +77,10 @@ class LogLevel {
   bool verbose_, detailed_;
 };
 
-std::string now_utc() {
-  const auto t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::ostringstream s;
-  s << std::put_time(std::gmtime(&t), "%Y-%m-%dT%H:%M:%SZ");
-  return s.str();
-}
-
 /// run.json as the command line writes it (app/cli.cpp), plus "driver".
 nlohmann::json run_json(const Context& ctx, const std::string& command, const std::string& status,
                         const std::string& message) {
-  nlohmann::json j = ctx.report.json();
-  j["command"] = command;
-  j["status"] = status;
-  if (!message.empty()) j["message"] = message;
-  j["case_file"] = ctx.config.file.string();
-  j["case"] = nlohmann::json::parse(ctx.config.resolved_json);
-  j["finished_utc"] = now_utc();
-  j["total_seconds"] = ctx.report.total_seconds();
-  j["peak_memory_mib"] = log::peak_memory_mib();
-  j["versions"] = {{"shroudsim", SHROUDSIM_VERSION},
-                   {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
-                                 std::to_string(EIGEN_MINOR_VERSION)},
-                   {"compiler", __VERSION__}};
+  nlohmann::json j = app::run_report(ctx, command, status, message);
   j["driver"] = "python";
   return j;
 }
