@@ -13,8 +13,10 @@
 // Tangential update of the coupled law (full3d): radial_return takes the trial force
 // T* = kt (w_t(l) - d(l-1)) and returns it radially onto |T| <= mu N(l) (first order on 2D
 // orbits); exact_linear takes w_t and the slip radius mu N/kt linear within each step and
-// integrates the stick/slip evolution exactly (second order; see exact_linear_step). For the
-// 1D laws (quasi3d per axis, 1d) both are the exact clamp and coincide.
+// integrates the stick/slip evolution exactly (second order; see exact_linear_step), and in a
+// step where the contact closes starts the slider at the closing instant (second order
+// through separation). For the 1D laws (quasi3d per axis, 1d) both are the exact clamp and
+// coincide, except in such a closing step.
 #include <optional>
 #include <string>
 #include <string_view>

@@ -15,6 +15,9 @@
 //   axis_radial_return  e = w(l) - d(l-1) clamped to lim/kt.
 //   axis_exact_linear   e(l-1) clamped to the start radius a0 = mu N(l-1)/kt (a no-op up to
 //                       round-off), the increment added, clamped to the end radius a1.
+//   axis_closing        exact_linear where the contact closes within the step: the slider at
+//                       the closing instant, the rest of the step clamped to the radius.
+// The coupled closing step is exact_linear_step(0, r dw, 0, a1) (periodic_law.cpp).
 // All but exact_linear_step are inline: the periodic law calls them once per sample.
 #include <Eigen/Core>
 #include <array>
@@ -80,16 +83,10 @@ inline AxisStep axis_radial_return(double w, double& d, double kt, double lim) {
   r.slip = sg;
   return r;
 }
-/// w, w_prev = w(l), w(l-1); slip radii a0 = mu N(l-1)/kt >= 0, a1 = mu N(l)/kt > 0.
-inline AxisStep axis_exact_linear(double w, double w_prev, double& d, double kt, double a0, double a1) {
+/// The clamp shared by the exact 1D updates: e1 = v clamped to |e1| <= a1, T = kt e1,
+/// d = w - e1; slip: the sign when clamped.
+inline AxisStep axis_clamp(double v, double w, double& d, double kt, double a1) {
   AxisStep r;
-  double e0 = w_prev - d;
-  if (std::abs(e0) > a0) {
-    const double sg = e0 > 0.0 ? 1.0 : -1.0;
-    e0 = a0 * sg;
-    r.start = sg;
-  }
-  const double v = e0 + (w - w_prev);
   double e1 = v;
   if (std::abs(v) > a1) {
     const double sg = v > 0.0 ? 1.0 : -1.0;
@@ -99,6 +96,25 @@ inline AxisStep axis_exact_linear(double w, double w_prev, double& d, double kt,
   r.t = kt * e1;
   d = w - e1;
   return r;
+}
+/// w, w_prev = w(l), w(l-1); slip radii a0 = mu N(l-1)/kt >= 0, a1 = mu N(l)/kt > 0.
+inline AxisStep axis_exact_linear(double w, double w_prev, double& d, double kt, double a0, double a1) {
+  double e0 = w_prev - d;
+  double start = 0.0;
+  if (std::abs(e0) > a0) {
+    start = e0 > 0.0 ? 1.0 : -1.0;
+    e0 = a0 * start;
+  }
+  AxisStep r = axis_clamp(e0 + (w - w_prev), w, d, kt, a1);
+  r.start = start;
+  return r;
+}
+/// axis_exact_linear for a step in which the contact closes (open at l-1, pressed at l): the
+/// slider starts at the closing instant (e = 0 there) and the remaining fraction r in (0, 1]
+/// of the step is integrated with the slip radius growing from 0 to a1 = mu N(l)/kt > 0:
+/// e(l) = r (w(l) - w(l-1)) clamped to a1.
+inline AxisStep axis_closing(double w, double w_prev, double r, double& d, double kt, double a1) {
+  return axis_clamp(r * (w - w_prev), w, d, kt, a1);
 }
 
 }  // namespace shroudsim::contact

@@ -88,7 +88,8 @@ void PeriodRecorder::radial_return_slip(const Eigen::MatrixXd& basis, int l, dou
 
 void PeriodRecorder::exact_linear_slip(const Eigen::MatrixXd& basis, int l, int lp, double kt, double kn, double mu,
                                        bool pressed_prev, const Eigen::Matrix<double, 2, 6>& jl, Eigen::RowVectorXd& x,
-                                       Eigen::RowVectorXd& y) {
+                                       Eigen::RowVectorXd& y, const std::array<double, 2>& z_prev,
+                                       const std::array<double, 2>& z_l) {
   const int n = static_cast<int>(basis.rows());
   const int m = static_cast<int>(basis.cols());
   const double ca = mu * kn / kt;
@@ -104,8 +105,8 @@ void PeriodRecorder::exact_linear_slip(const Eigen::MatrixXd& basis, int l, int 
     // de1_i = -J_i0 dd_x - J_i1 dd_y + u_i E(lp) + v_i E(l) within block blk
     double u[2], v[2];
     for (int i = 0; i < 2; ++i) {
-      u[i] = blk == 0 ? jl(i, 0) - jl(i, 2) : blk == 1 ? jl(i, 1) - jl(i, 3) : jl(i, 4) * cp;
-      v[i] = blk == 0 ? jl(i, 2) : blk == 1 ? jl(i, 3) : jl(i, 5) * ca;
+      u[i] = blk == 0 ? jl(i, 0) - jl(i, 2) : blk == 1 ? jl(i, 1) - jl(i, 3) : jl(i, 4) * cp + z_prev[i];
+      v[i] = blk == 0 ? jl(i, 2) : blk == 1 ? jl(i, 3) : jl(i, 5) * ca + z_l[i];
     }
     const double bx = blk == 0 ? 1.0 : 0.0, by = blk == 1 ? 1.0 : 0.0;
     for (int k = 0, c = blk * m; k < m; ++k, ++c) {

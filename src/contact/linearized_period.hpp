@@ -110,9 +110,12 @@ class PeriodRecorder {
   /// Jacobian jl = de1/d(e0x, e0y, dwx, dwy, a0, a1) (exact_linear_step):
   ///   de1 = J_e0 (E_t(lp) - X) + J_dw (E_t(l) - E_t(lp)) + J_a0 mu kn E_z(lp)/kt [pressed at lp]
   ///         + J_a1 mu kn E_z(l)/kt,          dT = kt de1,  X <- E_t(l) - de1.
+  /// z_prev, z_l: further coefficients of E_z(lp) and E_z(l) in de1 (the closing instant's
+  /// dependence on the normal motion, periodic_law.cpp; zero otherwise).
   void exact_linear_slip(const Eigen::MatrixXd& basis, int l, int lp, double kt, double kn, double mu,
                          bool pressed_prev, const Eigen::Matrix<double, 2, 6>& jl, Eigen::RowVectorXd& x,
-                         Eigen::RowVectorXd& y);
+                         Eigen::RowVectorXd& y, const std::array<double, 2>& z_prev = {0.0, 0.0},
+                         const std::array<double, 2>& z_l = {0.0, 0.0});
 
  private:
   LinearizedPeriod& lin_;

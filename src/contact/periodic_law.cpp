@@ -217,6 +217,12 @@ struct PeriodicLaw::Sample {
   double lim = 0.0;             // mu N(l) [N]
   double nprev = 0.0;           // N(lp) [N], for exact_linear
   bool pressed_prev = false;    // N0 + kn z(lp) > 0
+  // exact_linear, the contact closes within the step (open at lp, pressed at l): the fraction
+  // r of the step after the closing instant, where the normal load, linear within the step,
+  // crosses zero (docs/physics.md section 4, "Separation and re-contact"), and its
+  // derivatives with respect to z(l) and z(lp) [1/m].
+  bool closing = false;
+  double r = 1.0, dr_dz = 0.0, dr_dz_prev = 0.0;
 };
 
 // The updates of one sample, forced inline into period()'s sample loop: a call per sample is
@@ -294,12 +300,35 @@ template <bool kD>
   // step, from mu N(l-1)/kt to mu N(l)/kt.
   const double kt = pair.tangential_stiffness;
   const double mu = pair.friction_coefficient;
-  const Eigen::Vector2d e0(s.wpx - d_[0], s.wpy - d_[1]);
-  const Eigen::Vector2d dw(s.wx - s.wpx, s.wy - s.wpy);
   const double a_end = s.lim / kt;
-  const double a = mu * s.nprev / kt;
   Eigen::Matrix<double, 2, 6> jl;
   bool stuck = false;
+  if (s.closing) {
+    // The contact closes within the step: the slider is where the motion was at the closing
+    // instant (e = 0 there, whatever d was), and the step integrates the remaining fraction r
+    // with the slip radius growing from 0. The damper moves in this step even if it sticks,
+    // so the sample is an explicit row: de1 = r J_dw (E_t(l) - E_t(lp))
+    //   + J_dw dw (dr/dz(l) E_z(l) + dr/dz(lp) E_z(lp)) + J_a1 da1, J_e0 = J_a0 = 0.
+    const Eigen::Vector2d dw(s.wx - s.wpx, s.wy - s.wpy);
+    const Eigen::Vector2d e1 =
+        exact_linear_step(Eigen::Vector2d::Zero(), s.r * dw, 0.0, a_end, (kD || track) ? &jl : nullptr, &stuck);
+    d_ = {s.wx - e1.x(), s.wy - e1.y()};
+    if (kD || track) {
+      const Eigen::Vector2d jdw = jl.middleCols<2>(2) * dw;  // de1/dr
+      jl.leftCols<2>().setZero();
+      jl.col(4).setZero();
+      jl.middleCols<2>(2) *= s.r;
+      if (track) track_coupled_slip<kD>(Eigen::Matrix2d::Zero(), kt);  // e1 does not depend on d_start
+      if constexpr (kD)
+        rec->exact_linear_slip(*basis, s.l, s.lp, kt, pair.normal_stiffness, mu, false, jl, xd_, yd_,
+                               {s.dr_dz_prev * jdw.x(), s.dr_dz_prev * jdw.y()},
+                               {s.dr_dz * jdw.x(), s.dr_dz * jdw.y()});
+    }
+    return {kt * e1.x(), kt * e1.y()};
+  }
+  const Eigen::Vector2d e0(s.wpx - d_[0], s.wpy - d_[1]);
+  const Eigen::Vector2d dw(s.wx - s.wpx, s.wy - s.wpy);
+  const double a = mu * s.nprev / kt;
   Eigen::Vector2d e1 = exact_linear_step(e0, dw, a, a_end, kD ? &jl : nullptr, &stuck);
   // Forces-only tracking: the step's Jacobian only where it does not simply stick.
   if (!kD && track && !stuck) e1 = exact_linear_step(e0, dw, a, a_end, &jl, &stuck);
@@ -320,6 +349,7 @@ template <bool kD>
 
 template <bool kD>
 [[gnu::always_inline]] inline std::array<double, 2> PeriodicLaw::uncoupled(const PairParameters& pair, const Sample& s,
+                                                                           const Eigen::MatrixXd* basis,
                                                                            PeriodRecorder* rec) {
   // quasi3d (x and y) or 1d (x): independent 1D laws with limit mu N(l). Their slip is
   // memoryless, so the damper derivative is always X_i = alpha E_i(s) + beta E_z(s) for
@@ -335,13 +365,31 @@ template <bool kD>
   std::array<double, 2> t{0.0, 0.0};
   for (int i = 0; i < ndir; ++i) {
     const double wi = (i == 0) ? s.wx : s.wy;
+    const double wpi = (i == 0) ? s.wpx : s.wpy;
     AxisStep step;
     if (!exact) {
       step = axis_radial_return(wi, d_[i], kt, s.lim);
+    } else if (s.closing) {
+      step = axis_closing(wi, wpi, s.r, d_[i], kt, s.lim / kt);
+      if (step.slip == 0.0) {
+        // Stuck from the closing instant: d = (1 - r) w(l) + r w(lp), so the damper
+        // derivative X_i = (1 - r) E_i(l) + r E_i(lp) - (w(l) - w(lp)) (dr/dz(l) E_z(l) +
+        // dr/dz(lp) E_z(lp)) spans four basis rows: an explicit run row (xd_ / yd_), held
+        // until the next slip or separation.
+        if constexpr (kD) {
+          Eigen::RowVectorXd& x = i == 0 ? xd_ : yd_;
+          const int m = static_cast<int>(basis->cols());
+          const double dwi = wi - wpi;
+          x.setZero();
+          x.segment(i * m, m) = (1.0 - s.r) * basis->row(s.l) + s.r * basis->row(s.lp);
+          x.segment(2 * m, m) = -dwi * (s.dr_dz * basis->row(s.l) + s.dr_dz_prev * basis->row(s.lp));
+        }
+        anchor_[i] = {-1, 0.0, 0.0, true};
+      }
     } else {
       const double a_end = s.lim / kt;
       const double a = mu * s.nprev / kt;
-      step = axis_exact_linear(wi, (i == 0) ? s.wpx : s.wpy, d_[i], kt, a, a_end);
+      step = axis_exact_linear(wi, wpi, d_[i], kt, a, a_end);
     }
     if (step.slip != 0.0) {
       // Slipping at the sample: dT_i = sg mu kn E_z(l); X_i = E_i(l) - dT_i/kt.
@@ -354,7 +402,10 @@ template <bool kD>
         const double c_a = s.pressed_prev ? step.start : 0.0;
         anchor_[i] = {s.lp, 1.0, -c_a * ca};
       }
-      if constexpr (kD) rec->stick_anchored(i, s.l, anchor_[i].s, anchor_[i].alpha, anchor_[i].beta);
+      if constexpr (kD) {
+        if (anchor_[i].explicit_x) rec->stick(i, s.l, i == 0 ? xd_ : yd_);
+        else rec->stick_anchored(i, s.l, anchor_[i].s, anchor_[i].alpha, anchor_[i].beta);
+      }
     }
     t[static_cast<std::size_t>(i)] = step.t;
   }
@@ -395,21 +446,28 @@ void PeriodicLaw::period(const PairParameters& pair, const Eigen::MatrixX3d& w, 
     s.wy = two_d ? w(l, 1) : 0.0;
     s.wpx = w(s.lp, 0);
     s.wpy = two_d ? w(s.lp, 1) : 0.0;
-    double nl = has_normal ? n0 + kn * w(l, 2) : n0;
-    const bool pressed = nl > 0.0;
-    if (!pressed) nl = 0.0;
-    double nprev = has_normal ? n0 + kn * w(s.lp, 2) : n0;
-    s.pressed_prev = nprev > 0.0;
-    if (!s.pressed_prev) nprev = 0.0;
-    s.nprev = nprev;
+    const double nl_raw = has_normal ? n0 + kn * w(l, 2) : n0;
+    const double np_raw = has_normal ? n0 + kn * w(s.lp, 2) : n0;
+    const bool pressed = nl_raw > 0.0;
+    const double nl = pressed ? nl_raw : 0.0;
+    s.pressed_prev = np_raw > 0.0;
+    s.nprev = s.pressed_prev ? np_raw : 0.0;
     s.lim = mu * nl;
+    if (exact && has_normal && pressed && !s.pressed_prev) {
+      // r = N(l) / (N(l) - N(lp)) in (0, 1], N(lp) <= 0 < N(l).
+      const double span = nl_raw - np_raw;
+      s.closing = true;
+      s.r = nl_raw / span;
+      s.dr_dz = -kn * np_raw / (span * span);
+      s.dr_dz_prev = kn * nl_raw / (span * span);
+    }
     if constexpr (kD) rec->set_pressed(l, pressed && has_normal);
 
     std::array<double, 2> t{0.0, 0.0};
     if (!pressed || !(s.lim > 0.0)) separate<kD>(s, basis, rec, track);
     else if (coupled && !exact) t = coupled_radial_return<kD>(pair, s, basis, rec, track);
     else if (coupled) t = coupled_exact_linear<kD>(pair, s, basis, rec, track);
-    else t = uncoupled<kD>(pair, s, rec);
+    else t = uncoupled<kD>(pair, s, basis, rec);
     f(l, 0) = t[0];
     f(l, 1) = t[1];
     f(l, 2) = has_normal ? nl : 0.0;

@@ -67,9 +67,12 @@ class PeriodicLaw {
   PeriodicStatus run(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
                      const Eigen::MatrixXd* basis, LinearizedPeriod* lin);
 
-  struct Anchor {  // uncoupled models: damper derivative X_i = alpha E_i(s) + beta E_z(s)
+  // Uncoupled models: the damper derivative X_i = alpha E_i(s) + beta E_z(s), or, after a
+  // closing step that sticks (explicit_x), the row xd_ (x) or yd_ (y).
+  struct Anchor {
     int s = 0;
     double alpha = 0.0, beta = 0.0;
+    bool explicit_x = false;
   };
   /// One period from the current state (d_, anchor_, xd_, yd_), which it advances. track:
   /// also carry D_ = d(d)/d(d_start) (2 x 2, coupled model) and, with kWithDerivative, the
@@ -90,7 +93,8 @@ class PeriodicLaw {
   std::array<double, 2> coupled_exact_linear(const PairParameters& pair, const Sample& s, const Eigen::MatrixXd* basis,
                                              PeriodRecorder* rec, bool track);
   template <bool kWithDerivative>
-  std::array<double, 2> uncoupled(const PairParameters& pair, const Sample& s, PeriodRecorder* rec);
+  std::array<double, 2> uncoupled(const PairParameters& pair, const Sample& s, const Eigen::MatrixXd* basis,
+                                  PeriodRecorder* rec);
   /// Separation (or no friction): T = 0, the damper follows the motion.
   template <bool kWithDerivative>
   void separate(const Sample& s, const Eigen::MatrixXd* basis, PeriodRecorder* rec, bool track);
