@@ -503,10 +503,29 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
       out.peaks.push_back(peak);
     }
   }
-  std::sort(out.peaks.begin(), out.peaks.end(),
-            [](const ResponsePeak& a, const ResponsePeak& b) { return a.frequency_hz < b.frequency_hz; });
+  out.peaks = distinct_peaks(std::move(out.peaks), ao.lambda_scale);
   out.peak_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
+}
+
+std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double frequency_unit_hz) {
+  // Distinct peaks of a prominence of 2 % cannot be this close; copies measured on the default
+  // case at N = 512 were 1.3e-8 Hz and 5e-16 apart (the location is known to 1e-7 of a step,
+  // and steps are at most 0.25 units).
+  constexpr double kSamePeakFrequency = 1e-6;  // frequency units
+  constexpr double kSamePeakAmplitude = 1e-9;  // relative
+  std::stable_sort(peaks.begin(), peaks.end(),
+                   [](const ResponsePeak& a, const ResponsePeak& b) { return a.frequency_hz < b.frequency_hz; });
+  std::vector<ResponsePeak> distinct;
+  for (const ResponsePeak& pk : peaks) {
+    const bool copy = std::any_of(distinct.begin(), distinct.end(), [&](const ResponsePeak& q) {
+      return q.located && pk.located &&
+             std::abs(q.frequency_hz - pk.frequency_hz) <= kSamePeakFrequency * frequency_unit_hz &&
+             std::abs(q.amplitude_m - pk.amplitude_m) <= kSamePeakAmplitude * q.amplitude_m;
+    });
+    if (!copy) distinct.push_back(pk);
+  }
+  return distinct;
 }
 
 }  // namespace shroudsim::forced

@@ -76,6 +76,11 @@ struct ResponsePeak {
   bool located = false;  ///< located to solver tolerance (false: the sampled maximum)
 };
 
+/// The peaks by frequency, each resonance once: two located peaks within 1e-6 frequency units
+/// and 1e-9 of each other's amplitude are one peak found twice (a piece that passes over it
+/// again after folds, or two overlapping pieces); the first is kept.
+std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double frequency_unit_hz);
+
 struct FrequencyResponse {
   std::vector<continuation::BranchPoint> points;  ///< every point, piece after piece
   std::vector<int> piece;  ///< of each point: 0, 1 traced back from the end, 2 and 3 both ways from a gap's middle
