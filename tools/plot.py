@@ -13,6 +13,8 @@ Draws whatever the folder holds results for:
   contact.json         -> contact_loops.png (hysteresis loops of one contact pair)
   frf.csv              -> frf.png           (nonlinear and linear forced response)
   loops.csv            -> loops.png         (contact loops at the peak)
+  contact_map.csv      -> contact.png       (energy, stick/slip/open of each pair at each shape)
+  frf.vtu              -> shape.png         (the largest peak's deflection shape; needs meshio)
   study.csv            -> study.png         (peak amplitude and frequency over a sweep)
   trade.csv            -> trade.png         (error against cost per knob, study --convergence)
 Exits 0 when it drew everything it found, 1 on a plotting failure, 2 on bad usage.
@@ -31,6 +33,8 @@ PLOTS = [
     ("static_contact.csv", "plotting.modal_plots", "plot_static_contact"),
     ("contact.json", "plotting.contact_plots", "plot_contact"),
     ("frf.csv", "plotting.frf_plots", "plot_frf"),
+    ("contact_map.csv", "plotting.contact_plots", "plot_contact_map"),
+    ("frf.vtu", "plotting.shape_plots", "plot_shape"),
     ("study.csv", "plotting.study_plots", "plot_study"),
     ("trade.csv", "plotting.study_plots", "plot_trade"),
 ]

@@ -478,7 +478,7 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
     constexpr double kMinProminence = 0.02;  // a local maximum 2 % above its surroundings
     for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
       const std::size_t i = idx[m];
-      ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false};
+      ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false, out.points[i].x};
       if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
         int evaluations = 0;
         continuation::ScaledSystem sys(equations, ao, &evaluations);
@@ -497,7 +497,7 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
           out.summary.residual_evaluations += e.evaluations;
           if (!e.found) continue;
           peak.located = true;  // if no trial point beats the sampled one, it is the maximum to tolerance
-          if (e.value > peak.amplitude_m) peak.amplitude_m = e.value, peak.frequency_hz = e.lambda;
+          if (e.value > peak.amplitude_m) peak.amplitude_m = e.value, peak.frequency_hz = e.lambda, peak.x = e.x;
         }
       }
       out.peaks.push_back(peak);
@@ -526,6 +526,25 @@ std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double
     if (!copy) distinct.push_back(pk);
   }
   return distinct;
+}
+
+std::vector<Eigen::VectorXd> solutions_at_frequency(const FrequencyResponse& response, ReducedEquations& equations,
+                                                    double frequency_hz, int* failed) {
+  std::vector<Eigen::VectorXd> out;
+  if (failed) *failed = 0;
+  for (std::size_t i = 0; i + 1 < response.points.size(); ++i) {
+    if (response.piece[i] != response.piece[i + 1]) continue;
+    const continuation::BranchPoint& a = response.points[i];
+    const continuation::BranchPoint& b = response.points[i + 1];
+    const bool crosses = (a.lambda - frequency_hz) * (b.lambda - frequency_hz) < 0.0 || b.lambda == frequency_hz ||
+                         (i == 0 && a.lambda == frequency_hz);
+    if (!crosses) continue;
+    const double t = b.lambda == a.lambda ? 0.0 : (frequency_hz - a.lambda) / (b.lambda - a.lambda);
+    Eigen::VectorXd x = (1.0 - t) * a.x + t * b.x;
+    if (continuation::newton_fixed(equations, x, frequency_hz, response.options) >= 0) out.push_back(std::move(x));
+    else if (failed) ++*failed;
+  }
+  return out;
 }
 
 }  // namespace shroudsim::forced

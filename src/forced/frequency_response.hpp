@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include "continuation/arclength.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/linear_part.hpp"
+#include "frf/sector.hpp"
 #include "hbm/contact_evaluator.hpp"
 
 namespace shroudsim::forced {
@@ -32,6 +34,10 @@ namespace shroudsim::forced {
 struct ForcedModel {
   std::unique_ptr<frf::LinearPart> linear;
   std::vector<contact::PairParameters> pairs;
+  /// Sector models: the contact pairs and forcing the linear part was built from (for the
+  /// operating deflection shapes, frf::sector_displacements); empty for lumped models.
+  std::vector<frf::SectorContactPair> sector_pairs;
+  std::optional<frf::SectorForcing> sector_forcing;
 };
 
 struct FrequencyResponseSettings {
@@ -74,12 +80,22 @@ struct ResponsePeak {
   std::size_t point = 0;  ///< the sampled point nearest to it (index into points)
   int piece = 0;
   bool located = false;  ///< located to solver tolerance (false: the sampled maximum)
+  Eigen::VectorXd x;     ///< the solution (contact motion) there
 };
 
 /// The peaks by frequency, each resonance once: two located peaks within 1e-6 frequency units
 /// and 1e-9 of each other's amplitude are one peak found twice (a piece that passes over it
 /// again after folds, or two overlapping pieces); the first is kept.
 std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double frequency_unit_hz);
+
+struct FrequencyResponse;
+
+/// The solutions of the traced curve at `frequency_hz`: one per crossing of that frequency by
+/// a piece (several on an S-shaped stretch), each corrected by Newton at the fixed frequency
+/// from the interpolation between the two points around it. Crossings whose Newton fails are
+/// left out (failed: how many).
+std::vector<Eigen::VectorXd> solutions_at_frequency(const FrequencyResponse& response, ReducedEquations& equations,
+                                                    double frequency_hz, int* failed = nullptr);
 
 struct FrequencyResponse {
   std::vector<continuation::BranchPoint> points;  ///< every point, piece after piece

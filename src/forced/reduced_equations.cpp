@@ -458,4 +458,13 @@ PointResult ReducedEquations::analyse(const Eigen::VectorXd& w, double frequency
   return res;
 }
 
+std::vector<Eigen::VectorXcd> ReducedEquations::contact_force_harmonics(const Eigen::VectorXd& w) {
+  contacts_.evaluate(w, f_, nullptr);
+  const int h = contacts_.pair_layout().n_harmonics();
+  std::vector<Eigen::VectorXcd> forces(h + 1);
+  for (int n = 0; n <= h; ++n) forces[n] = complex_harmonic(f_, n);
+  forces[0] -= static_contact_load();
+  return forces;
+}
+
 }  // namespace shroudsim::forced

@@ -132,6 +132,9 @@ class ReducedEquations : public continuation::ParametricResidual {
 
   /// Response, harmonics and energy balance at a solution point.
   PointResult analyse(const Eigen::VectorXd& w, double frequency_hz, int time_points = 512);
+  /// The complex contact force harmonics F_n (n = 0..H, each of size c) of the solution w, as
+  /// the linear part receives them: F_0 less the static contact load (see analyse).
+  std::vector<Eigen::VectorXcd> contact_force_harmonics(const Eigen::VectorXd& w);
 
   const hbm::HarmonicLayout& pair_layout() const { return contacts_.pair_layout(); }
 

@@ -1,5 +1,7 @@
 #include "frf/sector.hpp"
 
+#include <optional>
+
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <numbers>
@@ -194,6 +196,62 @@ std::string SectorLinearPart::describe() const {
   for (const auto& [h, d] : dynamic_) s << " " << h << " (" << d.omega.size() << " modes)";
   s << (forcing_.residual_flexibility ? ", residual flexibility" : ", no residual flexibility") << ")";
   return s.str();
+}
+
+std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
+    const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
+    const std::function<modal::StiffnessFactor(int)>& factor, const std::vector<SectorContactPair>& pairs,
+    const SectorForcing& forcing, const std::vector<ShapeLoad>& loads) {
+  std::vector<std::vector<Eigen::VectorXcd>> out(loads.size());
+  if (loads.empty()) return out;
+  const int h_max = static_cast<int>(loads.front().forces.size()) - 1;
+  const int nb = sector.sectors();
+  const Eigen::Index c = 3 * static_cast<Eigen::Index>(pairs.size());
+  for (auto& o : out) o.resize(h_max + 1);
+  // Harmonics n grouped by harmonic index h, so that each K_h is factored once.
+  std::map<int, std::vector<int>> by_index;
+  for (int n = 0; n <= h_max; ++n) by_index[n == 0 ? 0 : ((n * forcing.engine_order) % nb + nb) % nb].push_back(n);
+  for (const auto& [h, harmonics] : by_index) {
+    const Eigen::SparseMatrix<Complex> rows = selection(pairs, forcing, sector, h, sector.n_full());
+    const Eigen::SparseMatrix<Complex> t = sector.expansion(h);
+    const Eigen::SparseMatrix<Complex> load_map = t.adjoint() * rows.adjoint();  // reduced x (c + 4)
+    const bool dynamic = harmonics.front() != 0 || harmonics.size() > 1;
+    const modal::ModalBasis* basis = nullptr;
+    if (dynamic) {
+      auto it = bases.find(h);
+      SHROUDSIM_CHECK(it != bases.end(), "modes of harmonic index " + std::to_string(h) + " given");
+      basis = &it->second;
+    }
+    const bool need_factor = harmonics.front() == 0 || forcing.residual_flexibility;
+    std::optional<modal::StiffnessFactor> k;
+    if (need_factor) k = factor(h);
+    for (std::size_t l = 0; l < loads.size(); ++l) {
+      for (int n : harmonics) {
+        SHROUDSIM_CHECK(loads[l].forces[n].size() == c, "contact forces of every pair");
+        Eigen::VectorXcd y = Eigen::VectorXcd::Zero(c + 4);
+        y.head(c) = -loads[l].forces[n];
+        if (n == 1) y(c + 3) = 1.0;
+        const Eigen::VectorXcd g = load_map * y;
+        Eigen::VectorXcd ur;
+        if (n == 0) {
+          ur = k->solve(Eigen::MatrixXcd(g)).col(0);
+        } else {
+          const double big_w = n * loads[l].w, z = forcing.damping_ratio;
+          const Eigen::VectorXcd modal = basis->phi.adjoint() * g;
+          Eigen::VectorXcd q(modal.size());
+          for (Eigen::Index r = 0; r < modal.size(); ++r) {
+            const double wr = basis->omega[r];
+            q[r] = modal[r] / Complex(wr * wr - big_w * big_w, 2.0 * z * wr * big_w);
+            if (forcing.residual_flexibility) q[r] -= modal[r] / (wr * wr);
+          }
+          ur = basis->phi * q;
+          if (forcing.residual_flexibility) ur += k->solve(Eigen::MatrixXcd(g)).col(0);
+        }
+        out[l][n] = t * ur;
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace shroudsim::frf

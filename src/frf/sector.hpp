@@ -97,4 +97,25 @@ class SectorLinearPart : public LinearPart {
   IndexData static_;                  ///< n = 0 (h = 0): exact static flexibility in flex
 };
 
+/// The loads of one operating deflection shape: fundamental circular frequency w [rad/s] and
+/// the complex contact force harmonics F_n (n = 0..H, 3 per pair in the pair's frame, F_0 about
+/// the static state), as the harmonic balance solved them.
+struct ShapeLoad {
+  double w = 0.0;
+  std::vector<Eigen::VectorXcd> forces;
+};
+
+/// The displacement harmonics U_n (n = 0..H) of every DOF of the sector (n_full, node-major
+/// x y z, global frame) under the excitation (harmonic 1) and the contact forces of each load,
+/// with the receptance SectorLinearPart uses: U_n = T_h R_h(n w) T_h^H C_h^H y_n,
+/// y_n = (-F_n, 0, delta_n1) on the rows (contact, response, excitation), R_h the modal sum
+/// with damping and, with forcing.residual_flexibility, the residual flexibility
+/// K_h^-1 - sum_r phi_r phi_r^H / w_r^2; n = 0: the static flexibility K_0^-1 (docs/physics.md
+/// section 3). The response and contact rows of U_n are the harmonic balance's response and
+/// relative displacements. One K_h factorization per harmonic index for all loads.
+std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
+    const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
+    const std::function<modal::StiffnessFactor(int)>& factor, const std::vector<SectorContactPair>& pairs,
+    const SectorForcing& forcing, const std::vector<ShapeLoad>& loads);
+
 }  // namespace shroudsim::frf

@@ -91,7 +91,9 @@ struct ExcitationSection {
 
 struct ResponseSection {
   std::array<double, 3> point;
-  int dof;  ///< lumped only
+  int dof;                           ///< lumped only
+  bool shapes = true;                ///< sector: frf.vtu, frf.pvd and contact.vtu (the ODS and contact maps)
+  std::vector<double> shapes_at_hz;  ///< further frequencies of shapes and contact maps [Hz]
 };
 
 /// A lumped contact element: one DOF per direction (-1: absent), to ground or to other DOFs.

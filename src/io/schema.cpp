@@ -488,6 +488,14 @@ Schema declare() {
           "lumped: dof < the size of structure.mass",
           [](const Case& c, const long long& v) { return !lumped(c) || v < lumped_size(c); },
           [](const Case& c, const long long&) { return "dof < " + size_text(c); });
+  d.boolean("response.shapes", at(&Case::response, &ResponseSection::shapes), true,
+            "frf: write the operating deflection shapes (sector: frf.vtu, frf.pvd) and contact maps (contact_map.csv, "
+            "sector: contact.vtu) at every resonance peak and at response.shapes_at_hz");
+  d.numbers("response.shapes_at_hz", at(&Case::response, &ResponseSection::shapes_at_hz), {}, "Hz",
+            "frf: further frequencies of shapes and contact maps (one per crossing of the curve)")
+      .rule("every frequency > 0 and finite", [](const Case&, const std::vector<double>& v) {
+        return std::all_of(v.begin(), v.end(), [](double f) { return f > 0.0 && std::isfinite(f); });
+      });
 
   d.section("contact", "shroud friction contact");
   d.choice("contact.model", at(&Case::contact, &C::model), contact::Model::full3d,

@@ -137,6 +137,8 @@ ForcedModel make_sector_model(Context& ctx) {
   const cyclic::CyclicSector& sector = modal.cyclic();
   model.linear = std::make_unique<frf::SectorLinearPart>(
       sector, modal.bases, [&](int h) { return modal.stiffness_factor(h); }, pairs, forcing, c.hbm.harmonics);
+  model.sector_pairs = pairs;
+  model.sector_forcing = forcing;
   ctx.report.stage("receptances", clock.seconds());
   auto& j = ctx.report.section("frf_model");
   j["contact_pairs"] = pairs.size();

@@ -16,6 +16,7 @@
 #include "hbm/contact_evaluator.hpp"
 #include "io/output.hpp"
 #include "pipeline/forced_model.hpp"
+#include "pipeline/forced_shapes.hpp"
 #include "study/curves.hpp"
 
 namespace shroudsim::pipeline {
@@ -198,6 +199,7 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   for (const auto& r : results) ctx.frf_curve.emplace_back(r.frequency_hz, r.amplitude);
   if (!response.points.empty()) write_loops_csv(ctx.out_dir / "loops.csv", evaluator, response.points[peak.point].x);
   write_peaks_csv(ctx.out_dir / "peaks.csv", response);
+  if (c.response.shapes && ctx.plots) write_shapes(ctx, model, evaluator, equations, response);
 
   double max_energy_error = 0.0, worst_energy_f = 0.0;
   int unconverged = 0;

@@ -196,12 +196,12 @@ TEST(FrequencyResponse, APeakFoundTwiceIsReportedOnce) {
   // to 1e-6, and a sampled (not located) maximum at the same place: four peaks, by frequency
   // (ties in input order).
   constexpr double kUnit = 0.6;  // Hz
-  std::vector<ResponsePeak> peaks{{200.1231711440621, 4.410422618626866e-05, 7, 0, true},
-                                  {206.7, 4.03e-05, 90, 1, false},
-                                  {200.12317113133594, 4.410422618629212e-05, 5, 0, true},
-                                  {200.1231712, 4.4104226186e-05, 300, 1, true},
-                                  {200.1237711, 4.41042e-05, 9, 0, true},
-                                  {200.12317113133594, 4.410422618629212e-05, 6, 0, false}};
+  std::vector<ResponsePeak> peaks{{200.1231711440621, 4.410422618626866e-05, 7, 0, true, {}},
+                                  {206.7, 4.03e-05, 90, 1, false, {}},
+                                  {200.12317113133594, 4.410422618629212e-05, 5, 0, true, {}},
+                                  {200.1231712, 4.4104226186e-05, 300, 1, true, {}},
+                                  {200.1237711, 4.41042e-05, 9, 0, true, {}},
+                                  {200.12317113133594, 4.410422618629212e-05, 6, 0, false, {}}};
   const std::vector<ResponsePeak> d = distinct_peaks(peaks, kUnit);
   ASSERT_EQ(d.size(), 4u);
   EXPECT_EQ(d[0].point, 5u);  // the lowest-frequency copy is kept

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseLU>
 #include <numbers>
+#include <random>
 
 #include "../common/coarse_sector.hpp"
 #include "cyclic/cyclic_sector.hpp"
@@ -121,6 +122,77 @@ TEST(SectorReceptance, ModalSumWithResidualFlexibilityMatchesTheDirectSolve) {
     part.harmonic(0, 1.0, r0);
     const Eigen::MatrixXcd q0 = direct(f, pairs, forcing, 0, 0.0);
     EXPECT_LT((r0.G - q0.topLeftCorner(9, 9)).norm(), 1e-10 * q0.topLeftCorner(9, 9).norm());
+  }
+}
+
+// The whole-sector displacement of the shapes (frf.vtu): its contact and response rows are the
+// receptance's (w_lin - G F, u_lin - H F) to round-off, for the static and dynamic harmonics
+// with and without residual flexibility; and below the first mode the whole field agrees with
+// a direct solve of (K_h - W^2 M_h) u = f over every DOF within the modal truncation.
+TEST(SectorShapes, WholeFieldHasTheReceptancesRowsAndMatchesTheDirectSolve) {
+  const Fixture f;
+  std::vector<SectorContactPair> pairs = some_pairs(f, 3, 2, 0.3, 0.2, Eigen::Vector3d(1, 2, 3));
+  SectorForcing forcing;
+  forcing.engine_order = 3;
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  modal::ModalOptions mo;
+  mo.modes = 20;
+  std::map<int, modal::ModalBasis> bases;
+  std::map<int, modal::StiffnessFactor> factors;
+  for (int h : {0, 3, 6}) {
+    auto r = modal::solve_harmonic(*f.sector, h, mo);
+    ASSERT_TRUE(r.report.ok()) << r.report.message;
+    bases[h] = r.basis;
+    factors[h] = r.stiffness.valid() ? r.stiffness : modal::factor_harmonic_stiffness(*f.sector, h);
+  }
+  auto factor = [&](int h) { return factors.at(h); };
+  const int c = 9;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  std::vector<Eigen::VectorXcd> forces(3, Eigen::VectorXcd(c));
+  for (auto& fn : forces)
+    for (int i = 0; i < c; ++i) fn[i] = Complex(g(rng), g(rng));
+  forces[0] = forces[0].real().cast<Complex>();  // the static harmonic is real
+  for (bool residual : {true, false}) {
+    for (double zeta : {0.02, 0.0}) {
+      forcing.residual_flexibility = residual;
+      forcing.damping_ratio = zeta;
+      const SectorLinearPart part(*f.sector, bases, factor, pairs, forcing, 2);
+      const double w = 0.5 * bases.at(3).omega[0];
+      const auto u = sector_displacements(*f.sector, bases, factor, pairs, forcing, {{w, forces}});
+      ASSERT_EQ(u.size(), 1u);
+      ASSERT_EQ(u[0].size(), 3u);
+      for (int n = 0; n <= 2; ++n) {
+        HarmonicReceptance rec;
+        part.harmonic(n, w, rec);
+        const int h = n == 0 ? 0 : part.harmonic_index(n);
+        const Eigen::VectorXcd w_rows = contact_rows(pairs, *f.sector, h, f.sector->n_full()) * u[0][n];
+        const Eigen::VectorXcd w_ref = rec.w_lin - rec.G * forces[n];
+        const Eigen::VectorXcd u_ref = rec.u_lin - rec.H * forces[n];
+        // Round-off of the two summation orders of the same modal sum and solves.
+        constexpr double kRoundOff = 1e-9;
+        EXPECT_LT((w_rows - w_ref).norm(), kRoundOff * w_ref.norm()) << "n " << n << " residual " << residual;
+        EXPECT_LT((u[0][n].segment(3 * forcing.response_node, 3) - u_ref).norm(), kRoundOff * u_ref.norm())
+            << "n " << n << " residual " << residual;
+      }
+      if (residual && zeta == 0.0) {
+        // Direct: u = T_h (K_h - W^2 M_h)^-1 T_h^H C^H y, y = (-F_1, 0, 1).
+        const int h = part.harmonic_index(1);
+        const auto kmh = f.sector->reduce(h);
+        Eigen::SparseMatrix<Complex> a = kmh.K - w * w * kmh.M;
+        a.makeCompressed();
+        Eigen::SparseLU<Eigen::SparseMatrix<Complex>> lu(a);
+        Eigen::SparseMatrix<Complex> rows = contact_rows(pairs, *f.sector, h, f.sector->n_full());
+        Eigen::VectorXcd load = Eigen::VectorXcd(rows.adjoint() * Eigen::VectorXcd(-forces[1]));
+        load.segment(3 * forcing.excitation_node, 3) += forcing.force.cast<Complex>();
+        const Eigen::SparseMatrix<Complex> t = f.sector->expansion(h);
+        const Eigen::VectorXcd ref = t * Eigen::VectorXcd(lu.solve(Eigen::VectorXcd(t.adjoint() * load)));
+        constexpr double kTruncation = 1e-3;  // as in ModalSumWithResidualFlexibilityMatchesTheDirectSolve
+        EXPECT_LT((u[0][1] - ref).norm(), kTruncation * ref.norm());
+      }
+    }
   }
 }
 

@@ -178,8 +178,10 @@ class SectorForcedResponse(unittest.TestCase):
         s = Scratch(self)
         cli_case = os.path.join(s.folder("cli_case", WHEEL), "shrouded_wheel.toml")
         py_case = os.path.join(s.folder("py_case", WHEEL), "shrouded_wheel.toml")
-        status, err = run_cli("frf", cli_case, "--out", "cli", "--quiet", "--threads", "2", *set_args(COARSE_WHEEL))
+        status, err = run_cli("frf", cli_case, "--out", "cli", "--quiet", "--threads", "2", *set_args(COARSE_WHEEL),
+                              "--set", "response.shapes_at_hz=[190.0, 300.0]")
         self.assertEqual(status, 0, err)
+        self.check_shapes("cli", err)
         case = shroudsim.Case(py_case, COARSE_WHEEL)
         r = case.frf(threads=2, quiet=True)
         self.assertEqual(r.report["frf_model"]["normal_preload_from"], "static")
@@ -220,6 +222,69 @@ class SectorForcedResponse(unittest.TestCase):
         self.assertEqual(mesh.nodes.shape, m.nodes.shape)
         self.assertEqual(mesh.elements.shape[1], 4)
         self.assertEqual(len(mesh.shroud_pairs), mesh.report["mesh"]["shroud_pairs"])
+
+
+    def check_shapes(self, out, err):
+        """frf.vtu, contact.vtu, the frame series and contact_map.csv of a sector forced
+        response, opened in their readers: fields, sizes, finite values, and the shape at the
+        response node is the curve's amplitude."""
+        report = json.loads(read_text(os.path.join(out, "run.json")))
+        shapes = report["shapes"]
+        names = [sh["name"] for sh in shapes]
+        self.assertIn("peak1", names)
+        self.assertIn("f190hz", names)  # 300 Hz lies outside the range: a warning, no shape
+        self.assertIn("does not reach 300 Hz", err)
+        counts = {"shapes": len(shapes)}
+        try:
+            import meshio
+        except ImportError:
+            self.skipTest("meshio is not installed")
+        frf = meshio.read(os.path.join(out, "frf.vtu"))
+        n = len(frf.points)
+        harmonics = COARSE_WHEEL["hbm.harmonics"]
+        node = report["frf_model"]["response_node"]
+        for sh in shapes:
+            for k in range(harmonics + 1):
+                for part in ("re", "im"):
+                    field = frf.point_data[f"{sh['name']}_u_h{k}_{part}_m"]
+                    self.assertEqual(field.shape, (n, 3))
+                    self.assertTrue(np.all(np.isfinite(field)))
+            amplitude = frf.point_data[f"{sh['name']}_amplitude_m"].reshape(-1)
+            self.assertEqual(amplitude.shape, (n,))
+            # max_t |u(t)| over 512 samples against the curve's sampled-and-refined maximum:
+            # (pi/512)^2/2 = 2e-5 for a first-harmonic motion, up to 5e-4 with H = 3 to 5
+            # harmonics; the field is stored in single precision (6e-8).
+            self.assertAlmostEqual(amplitude[node] / sh["amplitude_m"], 1.0, delta=5e-4)
+            self.assertGreater(amplitude.max(), 0.0)
+        # The largest peak's time series: frf.pvd lists 24 frames that exist and hold the shape.
+        pvd = read_text(os.path.join(out, "frf.pvd"))
+        frames = [line.split('file="')[1].split('"')[0] for line in pvd.splitlines() if "file=" in line]
+        self.assertEqual(len(frames), 24)
+        frame = meshio.read(os.path.join(out, frames[6]))
+        self.assertEqual(frame.point_data["displacement_m"].shape, (n, 3))
+        self.assertTrue(np.all(np.isfinite(frame.point_data["displacement_m"])))
+        # The contact map: on the face nodes, fractions that add up to one.
+        contact = meshio.read(os.path.join(out, "contact.vtu"))
+        on_face = contact.point_data["contact_pair"].reshape(-1) >= 0
+        pairs = report["frf_model"]["contact_pairs"]
+        self.assertGreaterEqual(on_face.sum(), 2 * pairs)
+        with open(os.path.join(out, "contact_map.csv"), newline="") as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual(len(rows), pairs * len(shapes))
+        column = lambda name, shape=None: np.array([float(r[name]) for r in rows if shape in (None, r["shape"])])
+        total = column("stick_fraction") + column("slip_fraction") + column("open_fraction")
+        np.testing.assert_allclose(total, 1.0, atol=1e-12)
+        self.assertTrue(np.all(column("energy_per_cycle_j") >= -1e-12))
+        energy = contact.point_data["peak1_energy_per_cycle_j"].reshape(-1)
+        self.assertTrue(np.all(np.isfinite(energy)))
+        self.assertEqual(energy[~on_face].max(), 0.0)
+        peak_energy = column("energy_per_cycle_j", "peak1")
+        self.assertAlmostEqual(energy[on_face].max(), peak_energy.max(), delta=1e-6 * peak_energy.max())
+        # The pairs' energies add up to the contact dissipation of the curve's energy balance
+        # at the peak: positive, as friction only dissipates.
+        self.assertGreater(peak_energy.sum(), 0.0)
+        counts.update(nodes=n, face_nodes=int(on_face.sum()), pairs=pairs)
+        print(f"shapes: {counts}", file=sys.stderr)
 
 
 class Errors(unittest.TestCase):
