@@ -1,10 +1,9 @@
 #include "frf/sector.hpp"
 
-#include <optional>
-
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -52,9 +51,9 @@ Eigen::SparseMatrix<Complex> contact_rows(const std::vector<SectorContactPair>& 
   return m;
 }
 
-int SectorLinearPart::harmonic_index(int n) const {
-  return ((n * forcing_.engine_order) % sectors_ + sectors_) % sectors_;
-}
+int harmonic_index(int n, int engine_order, int sectors) { return ((n * engine_order) % sectors + sectors) % sectors; }
+
+int SectorLinearPart::harmonic_index(int n) const { return frf::harmonic_index(n, forcing_.engine_order, sectors_); }
 
 SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
                                    const std::function<modal::StiffnessFactor(int)>& factor,
@@ -210,7 +209,7 @@ std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
   for (auto& o : out) o.resize(h_max + 1);
   // Harmonics n grouped by harmonic index h, so that each K_h is factored once.
   std::map<int, std::vector<int>> by_index;
-  for (int n = 0; n <= h_max; ++n) by_index[n == 0 ? 0 : ((n * forcing.engine_order) % nb + nb) % nb].push_back(n);
+  for (int n = 0; n <= h_max; ++n) by_index[harmonic_index(n, forcing.engine_order, nb)].push_back(n);
   for (const auto& [h, harmonics] : by_index) {
     const Eigen::SparseMatrix<Complex> rows = selection(pairs, forcing, sector, h, sector.n_full());
     const Eigen::SparseMatrix<Complex> t = sector.expansion(h);

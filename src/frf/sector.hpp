@@ -52,6 +52,9 @@ struct SectorForcing {
   bool residual_flexibility = true;
 };
 
+/// The harmonic index h_n = n m mod Nb that temporal harmonic n of engine order m excites.
+int harmonic_index(int n, int engine_order, int sectors);
+
 /// The contact rows B_h (3 per pair, n_full columns) of harmonic index h: row 3i + a is
 /// L_i(a, :) (u_q - exp(i h alpha) R u_p), summed with weights over a patch.
 Eigen::SparseMatrix<std::complex<double>> contact_rows(const std::vector<SectorContactPair>& pairs,

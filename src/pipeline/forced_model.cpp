@@ -75,11 +75,17 @@ void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
   }
 }
 
+std::vector<int> forced_harmonic_indices(const io::Case& c) {
+  std::set<int> needed;
+  for (int n = 1; n <= c.hbm.harmonics; ++n)
+    needed.insert(frf::harmonic_index(n, c.excitation.engine_order, c.structure.sectors));
+  return {needed.begin(), needed.end()};
+}
+
 ForcedModel make_sector_model(Context& ctx) {
   const io::Case& c = ctx.config;
-  const int nb = c.structure.sectors, m = c.excitation.engine_order;
-  std::set<int> needed;
-  for (int n = 1; n <= c.hbm.harmonics; ++n) needed.insert(((n * m) % nb + nb) % nb);
+  const int m = c.excitation.engine_order;
+  const std::vector<int> needed = forced_harmonic_indices(c);
   // contact.normal_preload = "static": the static shroud contact at the forced response's
   // speed, on the sector at rest plus its rotating operators (docs/physics.md section 8).
   std::optional<frf::StaticShroud> static_state;
@@ -97,7 +103,7 @@ ForcedModel make_sector_model(Context& ctx) {
   // modal solve) differs from it in round-off, so a run with the modes cached and one that solves them would
   // give different curves where the continuation's path is sensitive to round-off (the
   // default case: 649 points in two pieces against 343 in one, the same located peak).
-  ModalModel modal = run_modal_stage(ctx, std::vector<int>(needed.begin(), needed.end()), /*keep_factors=*/false,
+  ModalModel modal = run_modal_stage(ctx, needed, /*keep_factors=*/false,
                                      c.excitation.speed_rpm);  // > 0: the modes at that speed
   if (!modal.failures.empty()) throw NumericalError("modal stage failed: " + modal.failures.front());
   const mesh::Mesh& mesh = modal.mesh;
@@ -157,7 +163,7 @@ ForcedModel make_sector_model(Context& ctx) {
   }
   j["excitation_node"] = forcing.excitation_node;
   j["response_node"] = forcing.response_node;
-  j["harmonic_indices"] = std::vector<int>(needed.begin(), needed.end());
+  j["harmonic_indices"] = needed;
   std::ostringstream s;
   s << "frf: " << pairs.size()
     << (discretization == frf::ContactDiscretization::patches ? " contact patches over " : " of ") << face.size()

@@ -19,6 +19,9 @@ using forced::ForcedModel;
 
 /// structure.type = "lumped": M, K, C and [[contact.elements]].
 ForcedModel make_lumped_model(const io::Case& c);
+/// The harmonic indices a sector case's forced response needs: h_n = n m mod Nb, n = 1..H,
+/// sorted, unique (h = 0 of the static harmonic comes from K_0, not from modes).
+std::vector<int> forced_harmonic_indices(const io::Case& c);
 /// structure.type = "sector": modal receptances of the sector, shroud contact pairs.
 ForcedModel make_sector_model(Context& ctx);
 /// The excitation and response points of a sector case: InputError (naming the key) when the

@@ -5,7 +5,6 @@
 #include <complex>
 #include <filesystem>
 #include <numbers>
-#include <set>
 #include <sstream>
 #include <string>
 
@@ -15,6 +14,7 @@
 #include "frf/sector.hpp"
 #include "io/output.hpp"
 #include "io/vtu.hpp"
+#include "pipeline/forced_model.hpp"
 #include "pipeline/modal_stage.hpp"
 
 namespace shroudsim::pipeline {
@@ -96,11 +96,7 @@ void write_sector_files(Context& ctx, const forced::ForcedModel& model, const st
   modal_ctx.config = c;
   modal_ctx.out_dir = ctx.out_dir;
   modal_ctx.threads = ctx.threads;
-  const int nb = c.structure.sectors, m = c.excitation.engine_order;
-  std::set<int> needed;
-  for (int n = 1; n <= c.hbm.harmonics; ++n) needed.insert(((n * m) % nb + nb) % nb);
-  ModalModel modal =
-      run_modal_stage(modal_ctx, std::vector<int>(needed.begin(), needed.end()), false, c.excitation.speed_rpm);
+  ModalModel modal = run_modal_stage(modal_ctx, forced_harmonic_indices(c), false, c.excitation.speed_rpm);
   if (!modal.failures.empty()) throw NumericalError("shapes: modal stage failed: " + modal.failures.front());
   std::vector<frf::ShapeLoad> loads;
   for (std::size_t s = 0; s < shapes.size(); ++s)
