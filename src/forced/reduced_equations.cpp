@@ -220,6 +220,15 @@ bool ReducedEquations::evaluate(const Eigen::VectorXd& w, double frequency_hz, E
   return evaluate_impl(w, frequency_hz, r, J, dr_dlambda, false);
 }
 
+std::vector<Eigen::MatrixXd> ReducedEquations::contact_jacobian(const Eigen::VectorXd& w) {
+  Eigen::VectorXd f;
+  std::vector<Eigen::MatrixXd> blocks;
+  contacts_.evaluate(w, f, &blocks);
+  for (const auto& b : blocks)
+    if (!b.allFinite()) throw NumericalError("the contact Jacobian is not finite");
+  return blocks;
+}
+
 bool ReducedEquations::matrix_free() const {
   return solver_.kind == LinearSolverOptions::Kind::krylov ||
          (solver_.kind == LinearSolverOptions::Kind::automatic && size() + 1 >= solver_.krylov_min_size);

@@ -137,6 +137,11 @@ class ReducedEquations : public continuation::ParametricResidual {
   std::vector<Eigen::VectorXcd> contact_force_harmonics(const Eigen::VectorXd& w);
 
   const hbm::HarmonicLayout& pair_layout() const { return contacts_.pair_layout(); }
+  int n_pairs() const { return contacts_.n_pairs(); }
+  const frf::LinearPart& linear_part() const { return linear_; }
+  /// dF_p/dW_p of every pair at w (the contact Jacobian blocks of evaluate(), pair layout);
+  /// throws NumericalError when they are not finite.
+  std::vector<Eigen::MatrixXd> contact_jacobian(const Eigen::VectorXd& w);
 
  private:
   /// The complex G_n (c x c) and W_lin,n (c) of every harmonic at one frequency (and, when

@@ -19,6 +19,17 @@
 
 namespace shroudsim::frf {
 
+/// The linear part of temporal harmonic n as a second-order system in the Laplace variable s,
+/// for the Floquet analysis of periodic solutions (forced/stability.hpp):
+///   G_n(s) = P (s^2 M + s C + K)^-1 P^H + R,   G_n(n w) = G_n(s = i n w),
+/// with M, C, K real (m x m, M invertible), P complex (c x m) and R (c x c) a massless part
+/// (residual or static flexibility) taken as quasi-static. Harmonic -n is the complex
+/// conjugate structure (conj(P), conj(R)) of a real system.
+struct SecondOrderForm {
+  Eigen::MatrixXd M, C, K;
+  Eigen::MatrixXcd P, R;
+};
+
 struct HarmonicReceptance {
   Eigen::MatrixXcd G;      ///< c x c
   Eigen::VectorXcd w_lin;  ///< c
@@ -47,6 +58,13 @@ class LinearPart {
   /// drives this linear part, ascending: where its free response peaks. Used to size the
   /// continuation's displacement unit (forced/frequency_response.hpp); empty if unknown.
   virtual std::vector<double> resonances_hz() const { return {}; }
+  /// The second-order form of harmonic n >= 0; false when the model has none (no Floquet
+  /// analysis then).
+  virtual bool second_order_form(int n, SecondOrderForm& out) const {
+    (void)n;
+    (void)out;
+    return false;
+  }
   /// Human-readable description (for run.json).
   virtual std::string describe() const = 0;
 };

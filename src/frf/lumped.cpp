@@ -61,6 +61,15 @@ void LumpedLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const 
   out.u_lin = rf.segment(response_dof_, 1);
 }
 
+bool LumpedLinearPart::second_order_form(int /*n*/, SecondOrderForm& out) const {
+  out.M = m_;
+  out.C = c_;
+  out.K = k_;
+  out.P = b_.cast<std::complex<double>>();
+  out.R = Eigen::MatrixXcd::Zero(b_.rows(), b_.rows());
+  return true;
+}
+
 Eigen::VectorXcd LumpedLinearPart::displacement(int n, double w, const Eigen::VectorXcd& contact_force) const {
   const double big_w = n * w;
   const Eigen::MatrixXcd dyn = k_.cast<std::complex<double>>() - big_w * big_w * m_.cast<std::complex<double>>() +

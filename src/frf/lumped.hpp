@@ -31,6 +31,8 @@ class LumpedLinearPart : public LinearPart {
   void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
               double& viscous_dissipation) const override;
   std::string describe() const override;
+  /// M, C, K of the model, P = B (no massless part): the same for every harmonic.
+  bool second_order_form(int n, SecondOrderForm& out) const override;
   /// sqrt(eig(K, M)) / 2 pi.
   std::vector<double> resonances_hz() const override;
 

@@ -94,6 +94,7 @@ struct ResponseSection {
   int dof;                           ///< lumped only
   bool shapes = true;                ///< sector: frf.vtu, frf.pvd and contact.vtu (the ODS and contact maps)
   std::vector<double> shapes_at_hz;  ///< further frequencies of shapes and contact maps [Hz]
+  bool stability = true;             ///< frf: Floquet exponents of every point (Hill's method)
 };
 
 /// A lumped contact element: one DOF per direction (-1: absent), to ground or to other DOFs.

@@ -491,6 +491,9 @@ Schema declare() {
   d.boolean("response.shapes", at(&Case::response, &ResponseSection::shapes), true,
             "frf: write the operating deflection shapes (sector: frf.vtu, frf.pvd) and contact maps (contact_map.csv, "
             "sector: contact.vtu) at every resonance peak and at response.shapes_at_hz");
+  d.boolean("response.stability", at(&Case::response, &ResponseSection::stability), true,
+            "frf: the local stability of every point by Hill's method (frf.csv column `stable`, run.json "
+            "frf.stability with the changes of stability: folds, period doublings, Neimark-Sacker points)");
   d.numbers("response.shapes_at_hz", at(&Case::response, &ResponseSection::shapes_at_hz), {}, "Hz",
             "frf: further frequencies of shapes and contact maps (one per crossing of the curve)")
       .rule("every frequency > 0 and finite", [](const Case&, const std::vector<double>& v) {

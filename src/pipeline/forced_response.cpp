@@ -13,6 +13,7 @@
 #include "core/log.hpp"
 #include "forced/discretization_search.hpp"
 #include "forced/reduced_equations.hpp"
+#include "forced/stability.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "io/output.hpp"
 #include "pipeline/forced_model.hpp"
@@ -41,20 +42,83 @@ ReportedPeak reported_peak(const forced::FrequencyResponse& response) {
   return peak;
 }
 
-/// frf.csv: every point with its harmonic amplitudes and piece.
-void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyResponse& response, int harmonics) {
+/// frf.csv: every point with its harmonic amplitudes, piece and (when the model was analysed)
+/// stability: 1 stable, 0 unstable, -1 where the Floquet analysis of the point failed.
+void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyResponse& response, int harmonics,
+                   const std::vector<forced::FloquetResult>* stability = nullptr) {
   std::ostringstream csv;
   csv << "frequency_hz,amplitude_m,linear_amplitude_m,newton_iterations";
   for (int n = 0; n <= harmonics; ++n) csv << ",h" << n << "_m";
-  csv << ",piece\n";
+  csv << ",piece" << (stability ? ",stable" : "") << "\n";
   for (std::size_t i = 0; i < response.results.size(); ++i) {
     const auto& r = response.results[i];
     csv << io::format_number(r.frequency_hz) << "," << io::format_number(r.amplitude) << ","
         << io::format_number(r.linear_amplitude) << "," << response.points[i].newton_iterations;
     for (double a : r.harmonic_amplitudes) csv << "," << io::format_number(a);
-    csv << "," << response.piece[i] << "\n";
+    csv << "," << response.piece[i];
+    if (stability) {
+      const forced::FloquetResult& f = (*stability)[i];
+      csv << "," << (f.available ? (f.stable ? "1" : "0") : "-1");
+    }
+    csv << "\n";
   }
   io::write_file_atomic(file, csv.str());
+}
+
+/// The Floquet exponents of every point (forced/stability.hpp) and run.json's frf.stability:
+/// how many points are unstable, the changes of stability along each piece, the time taken.
+/// A point whose analysis fails is left out (empty in frf.csv) and counted.
+std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
+                                                     forced::ReducedEquations& equations) {
+  const log::Stopwatch clock;
+  std::vector<forced::FloquetResult> out(response.points.size());
+  std::vector<double> freq, amp;
+  int unstable = 0, failed = 0, size = 0;
+  std::string failure;
+  for (std::size_t i = 0; i < response.points.size(); ++i) {
+    try {
+      out[i] = forced::floquet_exponents(equations, response.points[i].x, response.points[i].lambda);
+    } catch (const NumericalError& e) {
+      ++failed;
+      failure = e.what();
+    }
+    if (!out[i].available) continue;
+    unstable += out[i].stable ? 0 : 1;
+    size = std::max(size, out[i].hill_size);
+  }
+  for (std::size_t i = 0; i < response.results.size(); ++i) {
+    freq.push_back(response.results[i].frequency_hz);
+    amp.push_back(response.results[i].amplitude);
+  }
+  auto& s = j["stability"];
+  s = nlohmann::json::object();
+  const bool any = std::any_of(out.begin(), out.end(), [](const auto& f) { return f.available; });
+  s["available"] = any || failed > 0;
+  if (!any && failed == 0) {
+    s["reason"] =
+        "the linear part has no second-order form: Hill's method is implemented for lumped models "
+        "(docs/physics.md section 9)";
+    log::info("frf: stability not analysed (Hill's method is implemented for lumped models)");
+    return out;
+  }
+  s["method"] = "hill";
+  s["selection"] = "symmetry";
+  s["neutral_tolerance"] = forced::kNeutralTolerance;
+  s["hill_size"] = size;
+  s["unstable_points"] = unstable;
+  s["failed_points"] = failed;
+  if (failed > 0) s["failure"] = failure;
+  s["changes"] = nlohmann::json::array();
+  for (const auto& c : forced::stability_changes(out, freq, amp, response.piece))
+    s["changes"].push_back({{"kind", forced::to_string(c.kind)},
+                            {"frequency_hz", c.frequency_hz},
+                            {"amplitude_m", c.amplitude_m},
+                            {"piece", response.piece[c.point]}});
+  s["seconds"] = clock.seconds();
+  log::info("frf: stability (Hill, " + std::to_string(size) + " exponents per point): " + std::to_string(unstable) +
+            " of " + std::to_string(out.size()) + " points unstable, " + std::to_string(s["changes"].size()) +
+            " changes of stability" + (failed ? ", " + std::to_string(failed) + " points not analysed" : ""));
+  return out;
 }
 
 /// loops.csv: the hysteresis loops (relative displacement, contact force over one period) of
@@ -194,7 +258,10 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   for (const auto& w : response.warnings) ctx.report.warn(w);
 
   const ReportedPeak peak = reported_peak(response);
-  write_frf_csv(ctx.out_dir / "frf.csv", response, c.hbm.harmonics);
+  std::vector<forced::FloquetResult> stability;
+  if (c.response.stability) stability = analyse_stability(j, response, equations);
+  const bool analysed = c.response.stability && j["stability"]["available"].get<bool>();
+  write_frf_csv(ctx.out_dir / "frf.csv", response, c.hbm.harmonics, analysed ? &stability : nullptr);
   ctx.frf_curve.clear();
   for (const auto& r : results) ctx.frf_curve.emplace_back(r.frequency_hz, r.amplitude);
   if (!response.points.empty()) write_loops_csv(ctx.out_dir / "loops.csv", evaluator, response.points[peak.point].x);

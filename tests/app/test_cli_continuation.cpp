@@ -330,5 +330,35 @@ frequency_end_hz = 1391.629964680137)");
   EXPECT_LT(widest, 0.01 * (f1 - f0));  // no stretch of the range left without points
 }
 
+TEST(CliContinuation, TheMiddleBranchBetweenTwoFoldsIsReportedUnstable) {
+  // cases/gap_oscillator.toml: a hardening gap oscillator whose curve leans over a fold pair.
+  // frf.csv's `stable` column is 0 exactly on a stretch traced backwards in frequency (up to the
+  // points next to each fold, where the curve is nearly vertical) and run.json lists two folds.
+  const Scratch s("stability_gap");
+  s.write("case.toml", slurp(std::filesystem::path(SHROUDSIM_SOURCE_DIR) / "cases" / "gap_oscillator.toml"));
+  const CliResult r = s.run("frf case.toml --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto frf = frf_of(s, "results/gap_oscillator");
+  ASSERT_TRUE(frf.contains("stability"));
+  const auto& st = frf["stability"];
+  EXPECT_TRUE(st["available"].get<bool>());
+  EXPECT_EQ(st["failed_points"].get<int>(), 0);
+  ASSERT_EQ(st["changes"].size(), 2u);
+  for (const auto& c : st["changes"]) EXPECT_EQ(c["kind"].get<std::string>(), "fold");
+  const auto rows = csv_rows(slurp(s.dir() / "results" / "gap_oscillator" / "frf.csv"));
+  ASSERT_GT(rows.size(), 10u);
+  ASSERT_EQ(rows[0].back(), "stable");
+  int unstable = 0, backwards_unstable = 0;
+  for (std::size_t i = 1; i + 1 < rows.size(); ++i) {
+    if (rows[i].back() != "0") continue;
+    ++unstable;
+    if (std::stod(rows[i + 1][0]) < std::stod(rows[i][0])) ++backwards_unstable;
+  }
+  EXPECT_EQ(unstable, st["unstable_points"].get<int>());
+  EXPECT_GT(unstable, 10);
+  // All but the points next to the folds (at most two at each) step backwards.
+  EXPECT_GE(backwards_unstable, unstable - 4);
+}
+
 }  // namespace
 }  // namespace shroudsim::testing

@@ -30,6 +30,8 @@ def plot_frf(result_dir):
         if i == 0 or p != piece[i - 1]:
             runs.append([])
         runs[-1].append(i)
+    stable = [r.get("stable", "") or "" for r in rows]
+    drawn_unstable = False
     fig, ax = plt.subplots(figsize=(8, 5))
     harmonics = [k for k in rows[0] if k.startswith("h") and k.endswith("_m")]
     # h0 is the static part, h1 dominates: the higher ones, at most the 6 largest (H can be
@@ -42,8 +44,21 @@ def plot_frf(result_dir):
         fr = [f[i] for i in run]
         first = n == 0
         ax.semilogy(fr, [lin[i] for i in run], color="0.6", lw=1, label="linear, contact open" if first else None)
-        ax.semilogy(fr, [a[i] for i in run], color="C0", lw=1.5,
-                    label=("nonlinear (friction contact)" + (f", {len(runs)} pieces" if len(runs) > 1 else "")) if first else None)
+        # Unstable stretches (frf.csv column `stable` = 0 at either end of a segment) dashed.
+        seg_unstable = [stable[run[j]] == "0" or stable[run[j + 1]] == "0" for j in range(len(run) - 1)] or [False]
+        start = 0
+        for j in range(1, len(seg_unstable) + 1):
+            if j == len(seg_unstable) or seg_unstable[j] != seg_unstable[start]:
+                idx = run[start:j + 1]
+                dashed = seg_unstable[start]
+                label = None
+                if first and start == 0:
+                    label = "nonlinear (friction contact)" + (f", {len(runs)} pieces" if len(runs) > 1 else "")
+                if dashed and not drawn_unstable:
+                    label, drawn_unstable = "unstable (Hill)", True
+                ax.semilogy([f[i] for i in idx], [a[i] for i in idx], color="C0", lw=1.5, ls="--" if dashed else "-",
+                            label=label)
+                start = j
         for c, k in enumerate(higher):
             ax.semilogy(fr, [max(float(rows[i][k]), 1e-30) for i in run], lw=0.7, ls="--", color=f"C{c + 1}",
                         label=(k[:-2] + (" (largest 6 of %d)" % (len(harmonics) - 2) if c == 0 and

@@ -1,0 +1,176 @@
+#include "forced/stability.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/error.hpp"
+
+namespace shroudsim::forced {
+namespace {
+using Complex = std::complex<double>;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+// Half a harmonic: the symmetric copy's eigenvector centroid lies within it.
+constexpr double kCentroidHalfWidth = 0.5;
+// stability_changes: a critical exponent whose imaginary part is within this many w of 0 (or
+// of w / 2) is a real crossing (or a period doubling); the companion eigenvalues of a real
+// exponent carry an imaginary part of round-off size only.
+constexpr double kKindTolerance = 0.05;
+}  // namespace
+
+double FloquetResult::spectral_radius(double frequency_hz) const { return std::exp(max_real / frequency_hz); }
+
+FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
+                                ExponentSelection selection) {
+  FloquetResult out;
+  const frf::LinearPart& linear = equations.linear_part();
+  const hbm::HarmonicLayout& layout = equations.pair_layout();
+  const int h = layout.n_harmonics(), nd = layout.n_directions(), pairs = equations.n_pairs();
+  const int c = linear.n_contact(), nk = 2 * h + 1, ne = c * nk;
+  const double omega = kTwoPi * frequency_hz;
+
+  // The second-order form of every harmonic 0..H (k < 0: the conjugate).
+  std::vector<frf::SecondOrderForm> forms(static_cast<std::size_t>(h + 1));
+  for (int n = 0; n <= h; ++n)
+    if (!linear.second_order_form(n, forms[static_cast<std::size_t>(n)])) return out;
+  out.available = true;
+  auto form = [&](int k) -> const frf::SecondOrderForm& { return forms[static_cast<std::size_t>(std::abs(k))]; };
+  std::vector<Eigen::Index> offset(static_cast<std::size_t>(nk + 1), 0);
+  for (int k = -h; k <= h; ++k)
+    offset[static_cast<std::size_t>(k + h + 1)] = offset[static_cast<std::size_t>(k + h)] + form(k).M.rows();
+  const Eigen::Index s = offset.back();
+  if (s == 0) throw NumericalError("no modes for the Floquet analysis");
+
+  // D in exponential coefficients: index (k + H) c + 3 p + d. Per pair and direction, the real
+  // coefficients [c0 | c1 s1 | ...] map to X_0 = c0, X_n = (c_n - i s_n) / 2,
+  // X_-n = (c_n + i s_n) / 2, and back c_n = X_n + X_-n, s_n = i (X_n - X_-n).
+  const std::vector<Eigen::MatrixXd> blocks = equations.contact_jacobian(w);
+  const int b = layout.size();
+  Eigen::MatrixXcd t = Eigen::MatrixXcd::Zero(b, b), t_inv = Eigen::MatrixXcd::Zero(b, b);
+  const Complex i1(0.0, 1.0);
+  for (int d = 0; d < nd; ++d) {
+    auto row = [&](int k) { return d * nk + k + h; };  // local exponential index
+    t(row(0), layout.index(d, 0)) = 1.0;
+    t_inv(layout.index(d, 0), row(0)) = 1.0;
+    for (int n = 1; n <= h; ++n) {
+      const int ic = layout.index(d, n, hbm::HarmonicLayout::Part::cosine);
+      const int is = layout.index(d, n, hbm::HarmonicLayout::Part::sine);
+      t(row(n), ic) = 0.5, t(row(n), is) = -0.5 * i1;
+      t(row(-n), ic) = 0.5, t(row(-n), is) = 0.5 * i1;
+      t_inv(ic, row(n)) = 1.0, t_inv(ic, row(-n)) = 1.0;
+      t_inv(is, row(n)) = i1, t_inv(is, row(-n)) = -i1;
+    }
+  }
+  Eigen::MatrixXcd dx = Eigen::MatrixXcd::Zero(ne, ne);
+  for (int p = 0; p < pairs; ++p) {
+    const Eigen::MatrixXcd local = t * blocks[static_cast<std::size_t>(p)].cast<Complex>() * t_inv;
+    for (int d1 = 0; d1 < nd; ++d1)
+      for (int k1 = -h; k1 <= h; ++k1)
+        for (int d2 = 0; d2 < nd; ++d2)
+          for (int k2 = -h; k2 <= h; ++k2)
+            dx((k1 + h) * c + 3 * p + d1, (k2 + h) * c + 3 * p + d2) = local(d1 * nk + k1 + h, d2 * nk + k2 + h);
+  }
+  // E = D (I + R D)^-1 = (I + D R)^-1 D, R block diagonal over k.
+  Eigen::MatrixXcd dr = Eigen::MatrixXcd::Zero(ne, ne);
+  bool massless = false;
+  for (int k = -h; k <= h; ++k) {
+    const Eigen::MatrixXcd r = k < 0 ? Eigen::MatrixXcd(form(k).R.conjugate()) : form(k).R;
+    if (r.size() == 0 || r.isZero(0.0)) continue;
+    massless = true;
+    dr.middleCols((k + h) * c, c) = dx.middleCols((k + h) * c, c) * r;
+  }
+  Eigen::MatrixXcd e = dx;
+  if (massless) e = (Eigen::MatrixXcd::Identity(ne, ne) + dr).partialPivLu().solve(dx);
+
+  // Phi = blockdiag(P_k); A0, A1, A2 over the modal unknowns, scaled by w (mu = lambda / w).
+  Eigen::MatrixXcd phi = Eigen::MatrixXcd::Zero(ne, s);
+  Eigen::MatrixXcd a0 = Eigen::MatrixXcd::Zero(s, s), a1 = Eigen::MatrixXcd::Zero(s, s);
+  Eigen::MatrixXd a2 = Eigen::MatrixXd::Zero(s, s);
+  for (int k = -h; k <= h; ++k) {
+    const frf::SecondOrderForm& f = form(k);
+    const Eigen::Index o = offset[static_cast<std::size_t>(k + h)], m = f.M.rows();
+    if (m == 0) continue;
+    phi.block((k + h) * c, o, c, m) = k < 0 ? Eigen::MatrixXcd(f.P.conjugate()) : f.P;
+    const double kw = k * omega;
+    a0.block(o, o, m, m) =
+        (f.K.cast<Complex>() + i1 * kw * f.C.cast<Complex>() - kw * kw * f.M.cast<Complex>()) / (omega * omega);
+    a1.block(o, o, m, m) = (f.C.cast<Complex>() + 2.0 * i1 * kw * f.M.cast<Complex>()) / omega;
+    a2.block(o, o, m, m) = f.M;
+  }
+  a0 += phi.adjoint() * e * phi / (omega * omega);
+  // Companion form: [0 I; -A2^-1 A0  -A2^-1 A1] [q; mu q] = mu [q; mu q].
+  const Eigen::PartialPivLU<Eigen::MatrixXcd> a2_lu(a2.cast<Complex>());
+  Eigen::MatrixXcd companion = Eigen::MatrixXcd::Zero(2 * s, 2 * s);
+  companion.topRightCorner(s, s).setIdentity();
+  companion.bottomLeftCorner(s, s) = -a2_lu.solve(a0);
+  companion.bottomRightCorner(s, s) = -a2_lu.solve(a1);
+  out.hill_size = static_cast<int>(2 * s);
+  if (!companion.allFinite()) throw NumericalError("the Hill matrix is not finite");
+  const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> solver(companion, selection == ExponentSelection::symmetry);
+  if (solver.info() != Eigen::Success) throw NumericalError("the Hill eigenproblem did not converge");
+  const Eigen::VectorXcd& mu = solver.eigenvalues();
+
+  std::vector<Complex> chosen;
+  if (selection == ExponentSelection::symmetry) {
+    for (Eigen::Index j = 0; j < mu.size(); ++j) {
+      const auto q = solver.eigenvectors().col(j).head(s);
+      double total = 0.0, moment = 0.0;
+      for (int k = -h; k <= h; ++k) {
+        const Eigen::Index o = offset[static_cast<std::size_t>(k + h)];
+        const double wk = q.segment(o, offset[static_cast<std::size_t>(k + h + 1)] - o).squaredNorm();
+        total += wk;
+        moment += k * wk;
+      }
+      if (total > 0.0 && std::abs(moment / total) <= kCentroidHalfWidth) chosen.push_back(mu[j]);
+    }
+  } else {
+    std::vector<Complex> all(mu.data(), mu.data() + mu.size());
+    std::sort(all.begin(), all.end(), [](Complex a, Complex b) { return std::abs(a.imag()) < std::abs(b.imag()); });
+    const std::size_t keep = std::min(all.size(), static_cast<std::size_t>(2 * form(1).M.rows()));
+    chosen.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep));
+  }
+  if (chosen.empty()) throw NumericalError("no Floquet exponent selected");
+  std::sort(chosen.begin(), chosen.end(), [](Complex a, Complex b) { return a.real() > b.real(); });
+  for (const Complex& m : chosen) out.exponents.push_back(m * omega);
+  out.max_real = out.exponents.front().real();
+  out.stable = chosen.front().real() <= kNeutralTolerance;
+  return out;
+}
+
+std::string to_string(StabilityChange::Kind kind) {
+  switch (kind) {
+    case StabilityChange::Kind::fold: return "fold";
+    case StabilityChange::Kind::period_doubling: return "period_doubling";
+    case StabilityChange::Kind::neimark_sacker: return "neimark_sacker";
+  }
+  return "fold";
+}
+
+std::vector<StabilityChange> stability_changes(const std::vector<FloquetResult>& stability,
+                                               const std::vector<double>& frequency_hz,
+                                               const std::vector<double>& amplitude_m, const std::vector<int>& piece) {
+  std::vector<StabilityChange> out;
+  for (std::size_t i = 0; i + 1 < stability.size(); ++i) {
+    const FloquetResult &a = stability[i], &b = stability[i + 1];
+    if (!a.available || !b.available || a.stable == b.stable || piece[i] != piece[i + 1]) continue;
+    const FloquetResult& unstable = a.stable ? b : a;
+    const double w = kTwoPi * (a.stable ? frequency_hz[i + 1] : frequency_hz[i]);
+    const double im = std::abs(unstable.exponents.front().imag()) / w;
+    StabilityChange c;
+    c.point = i;
+    c.kind = im < kKindTolerance                   ? StabilityChange::Kind::fold
+             : std::abs(im - 0.5) < kKindTolerance ? StabilityChange::Kind::period_doubling
+                                                   : StabilityChange::Kind::neimark_sacker;
+    // Where max_real / w crosses zero, linearly between the two points.
+    const double ra = a.max_real / (kTwoPi * frequency_hz[i]), rb = b.max_real / (kTwoPi * frequency_hz[i + 1]);
+    const double t = ra == rb ? 0.5 : std::clamp(ra / (ra - rb), 0.0, 1.0);
+    c.frequency_hz = frequency_hz[i] + t * (frequency_hz[i + 1] - frequency_hz[i]);
+    c.amplitude_m = amplitude_m[i] + t * (amplitude_m[i + 1] - amplitude_m[i]);
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace shroudsim::forced

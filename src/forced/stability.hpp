@@ -1,0 +1,74 @@
+#pragma once
+// Local stability of a periodic solution of the reduced harmonic balance equations by Hill's
+// method (docs/physics.md section 9).
+//
+// A perturbation of the contact motion e^{lambda t} p(t), p of period T = 2 pi / w, is written
+// in complex exponentials p = sum_k P_k e^{i k w t}, k = -H..H. The contact forces respond
+// through the contact Jacobian of the harmonic balance, D = dF/dW (the AFT linearization,
+// moved from cosine/sine to exponential coefficients), and the linear part through its
+// second-order form (frf::SecondOrderForm) at s_k = lambda + i k w:
+//   (s_k^2 M_k + s_k C_k + K_k) q_k = -P_k^H F_k,    W_k = P_k q_k - R_k F_k,    F = D W.
+// The massless part R (residual flexibility of the modes left out, the static flexibility of
+// the mean) is condensed into the contact as quasi-static: W = (I + R D)^-1 P q, so
+// F = E P q with E = D (I + R D)^-1. With mu = lambda / w (dimensionless, so the problem and
+// its tolerances do not depend on the unit of time) this is the quadratic eigenproblem
+//   (mu^2 A2 + mu A1 + A0) q = 0,   A2 = M_k,  A1 = (C_k + 2 i k w M_k) / w,
+//   A0 = (K_k + i k w C_k - k^2 w^2 M_k + P_k^H [E P q]_k) / w^2   (blocks over k),
+// solved as a linear eigenproblem of twice the size (companion form). Its 2 m (2H + 1)
+// eigenvalues hold each Floquet exponent 2H + 1 times, shifted by i k w; the truncation spoils
+// the copies whose eigenvectors crowd the outer harmonics. Selection:
+//   symmetry  (default) the exponents whose eigenvector's harmonic centroid
+//             sum_k k |q_k|^2 / sum_k |q_k|^2 lies within half a harmonic of 0;
+//   imaginary the 2 m exponents nearest the real axis (m = size of the k = 1 block).
+// The point is unstable when the largest real part of the selected exponents exceeds
+// kNeutralTolerance w. Floquet multipliers are exp(lambda T).
+#include <Eigen/Core>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "forced/reduced_equations.hpp"
+
+namespace shroudsim::forced {
+
+/// Largest Re(lambda) / w still counted as stable: the round-off of the companion eigenvalues
+/// (~1e-16 times the square of the highest modal frequency over w's) stays well below it, and
+/// the slowest decay of a model with 1e-6 modal damping (-1e-6) well above it.
+constexpr double kNeutralTolerance = 1e-9;
+
+enum class ExponentSelection { symmetry, imaginary };
+
+struct FloquetResult {
+  bool available = false;  ///< false: the linear part has no second-order form
+  bool stable = true;
+  /// The selected Floquet exponents lambda [1/s], by decreasing real part.
+  std::vector<std::complex<double>> exponents;
+  double max_real = 0.0;  ///< Re of the first one [1/s]
+  int hill_size = 0;      ///< dimension of the companion eigenproblem
+  /// The largest Floquet multiplier modulus, exp(max_real T).
+  double spectral_radius(double frequency_hz) const;
+};
+
+/// The Floquet exponents of the solution w of `equations` at frequency f [Hz].
+FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
+                                ExponentSelection selection = ExponentSelection::symmetry);
+
+/// Where the stability changes between two neighbouring points of a branch.
+struct StabilityChange {
+  enum class Kind { fold, period_doubling, neimark_sacker };
+  Kind kind = Kind::fold;
+  std::size_t point = 0;                         ///< the change lies between point and point + 1
+  double frequency_hz = 0.0, amplitude_m = 0.0;  ///< linear interpolation where max_real crosses 0
+};
+std::string to_string(StabilityChange::Kind kind);
+
+/// The changes of stability along consecutive points of one piece: the critical exponent's
+/// imaginary part names the kind (0: a real exponent crosses, a fold or a branch point; w / 2:
+/// period doubling; otherwise a complex pair, Neimark-Sacker). frequency_hz and amplitude_m are
+/// the points'; stability the points' results; piece the piece of each point (no change is
+/// looked for across pieces).
+std::vector<StabilityChange> stability_changes(const std::vector<FloquetResult>& stability,
+                                               const std::vector<double>& frequency_hz,
+                                               const std::vector<double>& amplitude_m, const std::vector<int>& piece);
+
+}  // namespace shroudsim::forced
