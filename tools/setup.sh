@@ -17,7 +17,7 @@ packages=(
   cmake make g++ pkg-config
   libeigen3-dev libspectra-dev libsuitesparse-dev libopenblas0-pthread libfftw3-dev
   libgmsh-dev gmsh
-  libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
+  libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libboost-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-meshio python3-matplotlib
   python3-dev pybind11-dev python3-pybind11

@@ -150,9 +150,29 @@ struct MotionSection {
   std::vector<MotionHarmonic> x, y, z;
 };
 
+/// How the points of a sampled study fill the unit cube (study/sampling.hpp).
+enum class SampleMethod { random, latin_hypercube, sobol };
+inline std::string to_string(SampleMethod m) {
+  return m == SampleMethod::random ? "random" : m == SampleMethod::sobol ? "sobol" : "latin_hypercube";
+}
+
+/// One uncertain input of a sampled study: a number key and its distribution, "uniform"
+/// (a = min, b = max), "normal" (a = mean, b = std) or "lognormal" (a = median, b = std of the
+/// logarithm).
+struct SampleInput {
+  std::string key;
+  std::string distribution;
+  double a = 0.0, b = 0.0;
+};
+
 struct StudySection {
   /// dotted key -> values, each a TOML value in text form (usable with --set).
   std::vector<std::pair<std::string, std::vector<std::string>>> vary;
+  std::vector<SampleInput> sample;  ///< sampled study: the uncertain inputs (empty: a sweep)
+  int samples = 100;
+  SampleMethod method = SampleMethod::latin_hypercube;
+  int seed = 1;
+  double threshold_m = 0.0;  ///< peak amplitude whose exceedance probability is reported (0: none)
 };
 
 /// A parsed, validated case. Default-constructed: every key at its schema default.

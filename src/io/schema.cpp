@@ -190,6 +190,75 @@ Vary read_vary(const Reader& r, const std::string& key, const Case&) {
   return out;
 }
 
+using Sample = std::vector<SampleInput>;
+
+/// study.sample: { "dotted.key" = { distribution = "uniform", min = .., max = .. }, ... }.
+Sample read_sample(const Reader& r, const std::string& key, const Case&) {
+  const toml::node& n = r.node(key);
+  auto t = n.as_table();
+  if (!t) r.fail(key, &n, key + ": expected a table { \"dotted.key\" = { distribution = ..., ... } }");
+  Sample out;
+  for (const auto& [k, v] : *t) {
+    const std::string vk(k.str());
+    const KeySpec* spec = find_key(vk);
+    if (!spec || vk.rfind("study.", 0) == 0)
+      r.fail(key, &v, key + ": '" + vk + "' is not a case key that can be sampled" + suggestion(vk));
+    if (spec->type != "number")
+      r.fail(key, &v, key + ": '" + vk + "' is a " + spec->type + " key; only number keys can be sampled");
+    auto d = v.as_table();
+    if (!d) r.fail(key, &v, key + ": '" + vk + "' needs a table { distribution = \"uniform\", min = ..., max = ... }");
+    SampleInput in;
+    in.key = vk;
+    auto dist = (*d)["distribution"].value<std::string>();
+    if (!dist || (*dist != "uniform" && *dist != "normal" && *dist != "lognormal"))
+      r.fail(key, &v, key + ": '" + vk + "': distribution must be one of \"uniform\" | \"normal\" | \"lognormal\"");
+    in.distribution = *dist;
+    const std::pair<const char*, const char*> names = *dist == "uniform"  ? std::pair{"min", "max"}
+                                                      : *dist == "normal" ? std::pair{"mean", "std"}
+                                                                          : std::pair{"median", "log_std"};
+    for (const auto& [field, value] : *d) {
+      const std::string f(field.str());
+      if (f != "distribution" && f != names.first && f != names.second)
+        r.fail(key, &value,
+               key + ": '" + vk + "': unknown field '" + f + "' for a " + *dist + " distribution (it takes " +
+                   names.first + " and " + names.second + ")");
+    }
+    auto field = [&](const char* name) {
+      const toml::node* f = d->get(name);
+      if (!f) r.fail(key, &v, key + ": '" + vk + "': a " + *dist + " distribution needs " + name);
+      std::optional<double> x = f->value<double>();
+      if (!x || !std::isfinite(*x))
+        r.fail(key, f, key + ": '" + vk + "': " + name + " must be a finite number, got " + value_text(*f));
+      return *x;
+    };
+    in.a = field(names.first);
+    in.b = field(names.second);
+    if (*dist == "uniform" && !(in.a < in.b)) r.fail(key, &v, key + ": '" + vk + "': needs min < max");
+    if (*dist != "uniform" && !(in.b > 0)) r.fail(key, &v, key + ": '" + vk + "': needs " + names.second + " > 0");
+    if (*dist == "lognormal" && !(in.a > 0)) r.fail(key, &v, key + ": '" + vk + "': needs median > 0");
+    out.push_back(in);
+  }
+  return out;
+}
+
+std::string sample_toml(const Sample& sample) {
+  std::string s;
+  for (const auto& in : sample) {
+    const bool uni = in.distribution == "uniform", nor = in.distribution == "normal";
+    s += (s.empty() ? "" : ", ") + schema::quoted(in.key) + " = { distribution = " + schema::quoted(in.distribution) +
+         ", " +
+         (uni   ? "min"
+          : nor ? "mean"
+                : "median") +
+         " = " + toml_float(in.a) + ", " +
+         (uni   ? "max"
+          : nor ? "std"
+                : "log_std") +
+         " = " + toml_float(in.b) + " }";
+  }
+  return s.empty() ? "{}" : "{ " + s + " }";
+}
+
 std::string vary_toml(const Vary& vary) {
   std::string s;
   for (const auto& [key, values] : vary)
@@ -649,6 +718,36 @@ Schema declare() {
     k.load = [](const Case& c) { return c.study.vary; };
     k.format = vary_toml;
   }
+  {
+    auto& k = d.other<Sample>("study.sample", "table { \"dotted.key\" = { distribution, ... } }", {}, "",
+                              "sampled study: each uncertain number key's distribution, { distribution = \"uniform\", "
+                              "min, max }, { distribution = \"normal\", mean, std } or { distribution = "
+                              "\"lognormal\", median, log_std }; the points are study.samples draws (not with "
+                              "study.vary)");
+    k.read_value = read_sample;
+    k.store = [](Case& c, const Sample& v) { c.study.sample = v; };
+    k.load = [](const Case& c) { return c.study.sample; };
+    k.format = sample_toml;
+  }
+  d.integer("study.samples", at(&Case::study, &StudySection::samples), 100, "",
+            "sampled study: how many points are drawn")
+      .range(1, 10'000);
+  d.choice("study.method", at(&Case::study, &StudySection::method), SampleMethod::latin_hypercube,
+           {SampleMethod::random, SampleMethod::latin_hypercube, SampleMethod::sobol}, to_string,
+           "sampled study: random (independent draws), latin_hypercube (one point in each of study.samples strata of "
+           "every input) or sobol (the Sobol sequence, study.seed points in)");
+  d.integer("study.seed", at(&Case::study, &StudySection::seed), 1, "",
+            "sampled study: seed of the random draws (sobol: how many points of the sequence are skipped)")
+      .range(0, 1'000'000'000);
+  d.number("study.threshold_m", at(&Case::study, &StudySection::threshold_m), 0.0, "m",
+           "sampled study: the peak amplitude whose exceedance probability is reported (0: none)")
+      .at_least(0);
+  d.section_rule("study.vary and study.sample are not both given (a sweep or a sampled study)",
+                 [](const Case& c) -> std::optional<std::pair<std::string, std::string>> {
+                   if (!c.study.vary.empty() && !c.study.sample.empty())
+                     return std::pair<std::string, std::string>{"study.sample", "not both study.vary and study.sample"};
+                   return std::nullopt;
+                 });
   return {d.keys(), d.sections()};
 }
 

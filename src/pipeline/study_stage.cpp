@@ -18,6 +18,7 @@
 #include "io/output.hpp"
 #include "linalg/parallel.hpp"
 #include "study/curves.hpp"
+#include "study/sampling.hpp"
 #include "study/trade_design.hpp"
 
 namespace shroudsim::pipeline {
@@ -251,13 +252,160 @@ StudyOutcome run_convergence(Context& ctx, const CaseRunner& run_case) {
   return outcome;
 }
 
+/// A message as one CSV field: no commas, quotes or line breaks.
+std::string csv_field(std::string s) {
+  for (char& ch : s)
+    if (ch == ',' || ch == '\n' || ch == '\r') ch = ';';
+    else if (ch == '"') ch = '\'';
+  return s;
+}
+
+study::Distribution distribution_of(const io::SampleInput& in) {
+  study::Distribution d;
+  d.kind = in.distribution == "uniform"  ? study::Distribution::Kind::uniform
+           : in.distribution == "normal" ? study::Distribution::Kind::normal
+                                         : study::Distribution::Kind::lognormal;
+  d.a = in.a, d.b = in.b;
+  return d;
+}
+
+nlohmann::json statistics_json(const study::SampleStatistics& s) {
+  return {{"count", s.count}, {"mean", s.mean}, {"std", s.std_dev}, {"min", s.min}, {"p05", s.p05},
+          {"p25", s.p25},     {"p50", s.p50},   {"p75", s.p75},     {"p95", s.p95}, {"max", s.max}};
+}
+
+/// A sampled study ([study] sample): study.samples points of the unit cube (study.method,
+/// study.seed) mapped through each input's distribution; a point whose drawn values the case
+/// refuses (e.g. a normal friction coefficient below 0) is recorded as failed with the reason
+/// and the others run. -> study.csv (one row per sample), run.json study.statistics (peak
+/// amplitude and frequency: mean, std, percentiles; the exceedance of study.threshold_m with its
+/// 95 % Wilson interval; Spearman's rank correlation of each input with both).
+StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
+  const io::Case& base = ctx.config;
+  const io::StudySection& st = base.study;
+  const int n = st.samples, dims = static_cast<int>(st.sample.size());
+  const study::SampleMethod method = st.method == io::SampleMethod::random  ? study::SampleMethod::random
+                                     : st.method == io::SampleMethod::sobol ? study::SampleMethod::sobol
+                                                                            : study::SampleMethod::latin_hypercube;
+  const auto unit = study::unit_samples(method, n, dims, static_cast<std::uint64_t>(st.seed));
+  std::vector<study::Distribution> dist;
+  for (const auto& in : st.sample) dist.push_back(distribution_of(in));
+  std::vector<std::vector<double>> drawn(static_cast<std::size_t>(n));
+  std::vector<StudyPoint> points(static_cast<std::size_t>(n));
+  std::vector<io::Case> cases;
+  std::vector<StudyPoint> runnable;
+  std::vector<std::size_t> runnable_index;
+  const int width = static_cast<int>(std::to_string(n).size());
+  for (int i = 0; i < n; ++i) {
+    StudyPoint& p = points[static_cast<std::size_t>(i)];
+    std::vector<std::string> sets = ctx.overrides;
+    for (int d = 0; d < dims; ++d) {
+      const double v =
+          dist[static_cast<std::size_t>(d)].quantile(unit[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)]);
+      drawn[static_cast<std::size_t>(i)].push_back(v);
+      p.values.emplace_back(st.sample[static_cast<std::size_t>(d)].key, io::format_number(v));
+      sets.push_back(st.sample[static_cast<std::size_t>(d)].key + "=" + io::format_number(v));
+    }
+    std::ostringstream folder;
+    folder << "sample_" << std::setw(width) << std::setfill('0') << i + 1;
+    p.folder = folder.str();
+    try {
+      cases.push_back(io::load_case(base.file, sets));
+      runnable.push_back(p);
+      runnable_index.push_back(static_cast<std::size_t>(i));
+    } catch (const InputError& e) {
+      p.status = 2;
+      p.message = std::string("the drawn values are not a valid case: ") + e.what();
+    }
+  }
+  log::info("study: sampled, " + std::to_string(n) + " points (" + io::to_string(st.method) + ", seed " +
+            std::to_string(st.seed) + "), " + std::to_string(n - static_cast<int>(runnable.size())) +
+            " refused by the case's rules");
+  int workers = 0;
+  if (!runnable.empty()) {
+    workers = run_points(ctx, cases, runnable, run_case);
+    for (std::size_t k = 0; k < runnable.size(); ++k) points[runnable_index[k]] = runnable[k];
+  }
+
+  std::ostringstream csv;
+  csv << "sample";
+  for (const auto& in : st.sample) csv << "," << in.key;
+  csv << ",status,peak_amplitude_m,peak_frequency_hz,points,seconds,folder,message\n";
+  int failed = 0;
+  std::vector<double> peaks, freqs;
+  std::vector<std::vector<double>> inputs(static_cast<std::size_t>(dims));
+  for (int i = 0; i < n; ++i) {
+    const StudyPoint& p = points[static_cast<std::size_t>(i)];
+    csv << i + 1;
+    for (const auto& [k, v] : p.values) csv << "," << v;
+    const bool ok = p.status == 0;
+    csv << "," << (ok ? "ok" : "failed") << "," << io::format_number(p.peak) << ","
+        << io::format_number(p.peak_frequency) << "," << p.points << "," << io::format_number(p.seconds) << ","
+        << p.folder << "," << csv_field(p.message) << "\n";
+    failed += !ok;
+    if (!ok) continue;
+    peaks.push_back(p.peak);
+    freqs.push_back(p.peak_frequency);
+    for (int d = 0; d < dims; ++d)
+      inputs[static_cast<std::size_t>(d)].push_back(drawn[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)]);
+  }
+  io::write_file_atomic(ctx.out_dir / "study.csv", csv.str());
+
+  nlohmann::json j = {{"sampled", true},  {"points", n},
+                      {"failed", failed}, {"workers", workers},
+                      {"samples", n},     {"method", io::to_string(st.method)},
+                      {"seed", st.seed},  {"inputs", nlohmann::json::array()}};
+  for (std::size_t d = 0; d < st.sample.size(); ++d)
+    j["inputs"].push_back({{"key", st.sample[d].key}, {"distribution", dist[d].describe()}});
+  if (!peaks.empty()) {
+    const study::SampleStatistics a = study::summarize(peaks), f = study::summarize(freqs);
+    j["statistics"] = {{"peak_amplitude_m", statistics_json(a)}, {"peak_frequency_hz", statistics_json(f)}};
+    if (st.threshold_m > 0) {
+      const study::Exceedance e = study::exceedance(peaks, st.threshold_m);
+      j["exceedance"] = {{"threshold_m", st.threshold_m},
+                         {"probability", e.probability},
+                         {"low_95", e.low},
+                         {"high_95", e.high},
+                         {"above", e.above},
+                         {"count", e.count}};
+    }
+    j["sensitivity"] = nlohmann::json::array();
+    for (std::size_t d = 0; d < st.sample.size(); ++d) {
+      const auto ra = study::spearman(inputs[d], peaks), rf = study::spearman(inputs[d], freqs);
+      j["sensitivity"].push_back({{"key", st.sample[d].key},
+                                  {"spearman_peak_amplitude", ra ? nlohmann::json(*ra) : nlohmann::json(nullptr)},
+                                  {"spearman_peak_frequency", rf ? nlohmann::json(*rf) : nlohmann::json(nullptr)}});
+    }
+    std::ostringstream s;
+    s << "study: peak amplitude over " << a.count << " samples: mean " << io::format_number(a.mean) << " m, std "
+      << io::format_number(a.std_dev) << " m, 5 % / 50 % / 95 % " << io::format_number(a.p05) << " / "
+      << io::format_number(a.p50) << " / " << io::format_number(a.p95) << " m";
+    if (j.contains("exceedance"))
+      s << "; P(peak > " << io::format_number(st.threshold_m) << " m) = " << std::setprecision(3)
+        << j["exceedance"]["probability"].get<double>() << " [" << j["exceedance"]["low_95"].get<double>() << ", "
+        << j["exceedance"]["high_95"].get<double>() << "]";
+    log::info(s.str());
+  }
+  // Also on its own for the plot (drawn before run.json is written).
+  io::write_file_atomic(ctx.out_dir / "study_statistics.json", j.dump(2) + "\n");
+  ctx.report.section("study") = j;
+  StudyOutcome outcome;
+  if (failed)
+    outcome.warning =
+        std::to_string(failed) + " of " + std::to_string(n) + " samples failed (see study.csv, column message)";
+  return outcome;
+}
+
 }  // namespace
 
 StudyOutcome run_study(Context& ctx, const CaseRunner& run_case) {
   if (ctx.convergence) return run_convergence(ctx, run_case);
+  if (!ctx.config.study.sample.empty()) return run_sampled(ctx, run_case);
   const io::Case& base = ctx.config;
   if (base.study.vary.empty())
-    throw InputError(base.locations.at("study.vary") + ": study.vary is empty: name at least one key and its values");
+    throw InputError(base.locations.at("study.vary") +
+                     ": study.vary and study.sample are empty: name at least one key and its values (a sweep) or "
+                     "its distribution (a sampled study)");
   // Bounded work: the product's size before any point is built.
   constexpr double kMaxStudyPoints = 10000;
   double count = 1;

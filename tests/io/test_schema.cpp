@@ -62,8 +62,8 @@ TEST(Schema, EveryWordOfAChoiceReadsBackAsItself) {
     }
   }
   // structure.type, modal.eigensolver, modal.shroud, contact.model, contact.discretization,
-  // contact.tangential_update, hbm.jacobian
-  EXPECT_EQ(choices, 7);
+  // contact.tangential_update, hbm.jacobian, study.method
+  EXPECT_EQ(choices, 8);
 }
 
 TEST(Schema, MessagesQuoteTheDocumentedRule) {

@@ -1,10 +1,63 @@
 #!/usr/bin/python3
 """study.png: peak amplitude (and its frequency) against the first varied key, one line per
-combination of the other keys."""
+combination of the other keys; for a sampled study, the peak amplitude's distribution and its
+dependence on each uncertain input."""
 import csv
 import os
 
 from plotting import result_name
+
+
+def plot_sampled(result_dir, rows):
+    """A sampled study (first column `sample`): the histogram of the peak amplitude with its
+    5/50/95 % percentiles (and the threshold's exceedance, study_statistics.json), and the peak
+    amplitude against each uncertain input with Spearman's rank correlation."""
+    import json
+
+    import matplotlib.pyplot as plt
+
+    fixed = ["sample", "status", "peak_amplitude_m", "peak_frequency_hz", "points", "seconds", "folder", "message"]
+    inputs = [k for k in rows[0] if k not in fixed]
+    ok = [r for r in rows if r["status"] == "ok"]
+    if not ok:
+        return
+    peaks = sorted(float(r["peak_amplitude_m"]) for r in ok)
+    study = {}
+    stats_json = os.path.join(result_dir, "study_statistics.json")
+    if os.path.exists(stats_json):
+        with open(stats_json) as f:
+            study = json.load(f)
+    fig, axes = plt.subplots(1, 1 + len(inputs), figsize=(4.5 * (1 + len(inputs)), 4.2))
+    ax = axes[0]
+    ax.hist(peaks, bins=max(5, min(40, len(peaks) // 5)), color="C0", alpha=0.8)
+    stats = study.get("statistics", {}).get("peak_amplitude_m", {})
+    for key, style in (("p05", ":"), ("p50", "-"), ("p95", ":")):
+        if key in stats:
+            ax.axvline(stats[key], color="k", ls=style, lw=1, label=f"{int(key[1:])} %: {stats[key]:.4g} m")
+    exc = study.get("exceedance")
+    if exc:
+        ax.axvline(exc["threshold_m"], color="C3", lw=1.5,
+                   label=f"P(> {exc['threshold_m']:.3g} m) = {exc['probability']:.3f} "
+                         f"[{exc['low_95']:.3f}, {exc['high_95']:.3f}]")
+    ax.set_xlabel("peak amplitude [m]")
+    ax.set_ylabel("samples")
+    ax.set_title(f"{result_name(result_dir)}: {len(ok)} of {len(rows)} samples", fontsize=9)
+    ax.legend(fontsize=7)
+    rho = {s["key"]: s.get("spearman_peak_amplitude") for s in study.get("sensitivity", [])}
+    for bx, key in zip(axes[1:], inputs):
+        bx.plot([float(r[key]) for r in ok], [float(r["peak_amplitude_m"]) for r in ok], "o", ms=3)
+        failed = [r for r in rows if r["status"] != "ok"]
+        for r in failed:
+            bx.axvline(float(r[key]), color="C3", lw=0.5, alpha=0.5)
+        r_text = f", Spearman {rho[key]:+.2f}" if rho.get(key) is not None else ""
+        bx.set_title(f"{key}{r_text}", fontsize=9)
+        bx.set_xlabel(key)
+        bx.set_ylabel("peak amplitude [m]")
+    for a in axes:
+        a.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(result_dir, "study.png"), dpi=110)
+    plt.close(fig)
 
 
 def plot_study(result_dir):
@@ -13,6 +66,9 @@ def plot_study(result_dir):
     with open(os.path.join(result_dir, "study.csv"), newline="") as f:
         rows = [r for r in csv.DictReader(f)]
     if not rows:
+        return
+    if next(iter(rows[0])) == "sample":
+        plot_sampled(result_dir, rows)
         return
     fixed = ["status", "peak_amplitude_m", "peak_frequency_hz", "points", "seconds", "folder"]
     keys = [k for k in rows[0] if k not in fixed]
