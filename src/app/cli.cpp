@@ -31,6 +31,7 @@ struct CommonOptions {
   bool verbose = false;
   int threads = 0;
   bool convergence = false;  ///< study only
+  bool resume = false;       ///< study only
 };
 
 void add_common(CLI::App* sub, CommonOptions& o) {
@@ -148,6 +149,10 @@ int run_cli(int argc, char** argv) {
       sub->add_flag("--convergence", options[i].convergence,
                     "vary every accuracy knob (mesh, modes, residual flexibility, H, N, update, model, Jacobian) "
                     "around the case against its finest value -> trade.csv, trade.png");
+    if (std::string_view(subs[i].name) == "study")
+      sub->add_flag("--resume", options[i].resume,
+                    "start from what an interrupted (killed) or earlier study wrote into the results folder: its "
+                    "finished points whose run.json holds the same case are reused, the others run");
     commands.push_back(sub);
   }
 
@@ -201,7 +206,7 @@ int run_cli(int argc, char** argv) {
   try {
     folder = std::make_unique<io::ResultsFolder>(
         o.out.empty() ? std::filesystem::path("results") / ctx.config.name : std::filesystem::path(o.out),
-        o.out.empty() ? "results folder (results/<name>)" : "--out");
+        o.out.empty() ? "results folder (results/<name>)" : "--out", o.resume);
   } catch (const InputError& e) {
     std::cerr << "shroudsim: error: " << e.what() << "\n";
     return 2;
@@ -210,6 +215,10 @@ int run_cli(int argc, char** argv) {
   ctx.threads = o.threads;
   ctx.overrides = o.sets;
   ctx.convergence = o.convergence;
+  ctx.resume = o.resume;
+  if (o.resume)
+    log::info("study --resume: " + (folder->resumed_from().empty() ? std::string("nothing to resume from")
+                                                                   : "from " + folder->resumed_from()));
   const std::string command = subs[chosen].name;
 
   int status = 1;

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 #include "core/error.hpp"
 
@@ -29,7 +30,7 @@ bool is_results_folder(const fs::path& p) {
 
 }  // namespace
 
-ResultsFolder::ResultsFolder(fs::path target, const std::string& option) {
+ResultsFolder::ResultsFolder(fs::path target, const std::string& option, bool resume) {
   std::error_code ec;
   target = fs::absolute(target, ec).lexically_normal();
   if (!target.has_filename()) target = target.parent_path();  // "dir/" -> "dir"
@@ -63,12 +64,32 @@ ResultsFolder::ResultsFolder(fs::path target, const std::string& option) {
                      ": another shroudsim run is writing this results folder; wait for it to finish or "
                      "choose another folder");
   }
-  // Holding the lock, any staging folder of this target is a killed run's: remove it.
+  // Holding the lock, any staging folder of this target is a killed run's: removed, or with
+  // resume the newest is kept as this run's staging folder.
+  staging_ = parent / ("." + leaf + ".staging-" + std::to_string(::getpid()));
+  fs::path newest;
+  fs::file_time_type newest_time{};
+  std::vector<fs::path> killed;
   for (const auto& e : fs::directory_iterator(parent, ec)) {
     const std::string n = e.path().filename().string();
-    if (n.rfind("." + leaf + ".staging-", 0) == 0) fs::remove_all(e.path(), ec);
+    if (n.rfind("." + leaf + ".staging-", 0) != 0) continue;
+    killed.push_back(e.path());
+    const auto t = fs::last_write_time(e.path(), ec);
+    if (resume && (newest.empty() || t > newest_time)) newest = e.path(), newest_time = t;
   }
-  staging_ = parent / ("." + leaf + ".staging-" + std::to_string(::getpid()));
+  for (const auto& k : killed)
+    if (k != newest) fs::remove_all(k, ec);
+  if (!newest.empty()) {
+    fs::rename(newest, staging_, ec);
+    if (!ec) resumed_from_ = "a killed run";
+  } else if (resume && fs::is_directory(target_, ec)) {
+    // A finished run: its point folders (not its top-level files, which this run rewrites).
+    fs::create_directories(staging_, ec);
+    for (const auto& e : fs::directory_iterator(target_, ec))
+      if (e.is_directory()) fs::copy(e.path(), staging_ / e.path().filename(), fs::copy_options::recursive, ec);
+    if (!ec) resumed_from_ = "the previous results";
+  }
+  ec.clear();
   fs::create_directories(staging_, ec);
   if (ec) {
     ::close(lock_fd_);

@@ -24,7 +24,10 @@ class ResultsFolder {
   /// when the target is a file or a folder that is not a results folder, its parent cannot
   /// be created or written, the name is too long for the file system, or another run holds
   /// the lock.
-  ResultsFolder(std::filesystem::path target, const std::string& option);
+  /// resume (`study --resume`): the new run starts from what an earlier one wrote: a killed
+  /// run's staging folder (the newest, renamed to this run's), else a copy of the target's
+  /// subfolders (the points of a finished study); resumed_from() says which.
+  ResultsFolder(std::filesystem::path target, const std::string& option, bool resume = false);
   ~ResultsFolder();
   ResultsFolder(const ResultsFolder&) = delete;
   ResultsFolder& operator=(const ResultsFolder&) = delete;
@@ -34,9 +37,12 @@ class ResultsFolder {
   /// The staging folder becomes the target (the old target is removed). Throws
   /// std::runtime_error when the file system refuses.
   void commit();
+  /// "" (a fresh start), "a killed run" or "the previous results".
+  const std::string& resumed_from() const { return resumed_from_; }
 
  private:
   std::filesystem::path target_, staging_;
+  std::string resumed_from_;
   int lock_fd_ = -1;
   bool committed_ = false;
 };

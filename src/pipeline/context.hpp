@@ -36,6 +36,7 @@ struct Context {
   std::vector<std::string> overrides;  ///< the command line's --set KEY=VALUE, in order
   bool plots = true;                   ///< draw plots after a command (off for study points)
   bool convergence = false;            ///< `study --convergence`: the accuracy/speed trade
+  bool resume = false;                 ///< `study --resume`: reuse the finished points in out_dir
   /// (frequency [Hz], amplitude [m]) of the forced response cmd_frf traced (as in frf.csv).
   std::vector<std::pair<double, double>> frf_curve;
   RunReport report;

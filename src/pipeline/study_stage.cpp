@@ -5,6 +5,8 @@
 #include <atomic>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -56,18 +58,56 @@ double thread_cpu_seconds() {
 
 /// Runs every point (the case `cases[i]` into <out>/<points[i].folder>) on --threads workers,
 /// quietly, one line each; fills status, message, peak, points and seconds. Returns the
-/// number of workers used.
+/// number of workers used; reused_points: how many finished points --resume reused.
 int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<StudyPoint>& points,
-               const CaseRunner& run_case) {
-  const int workers = linalg::worker_count(ctx.threads, static_cast<int>(points.size()));
-  log::info("study: " + std::to_string(points.size()) + " points on " + std::to_string(workers) + " workers");
+               const CaseRunner& run_case, int* reused_points = nullptr) {
+  // --resume: a point whose folder holds a run.json of status ok for the same case (its
+  // fingerprint: the resolved case, every key) is reused as it is; any other folder of a point
+  // (a failed point, a point killed half-written, a point of another case) is cleared and run.
+  std::vector<int> to_run;
+  int reused = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const std::filesystem::path dir = ctx.out_dir / points[i].folder;
+    std::error_code ec;
+    if (ctx.resume && std::filesystem::exists(dir / "run.json", ec)) {
+      try {
+        std::ifstream in(dir / "run.json");
+        const auto j = nlohmann::json::parse(in);
+        if (j.value("status", "") == "ok" && j.contains("case") &&
+            j["case"] == nlohmann::json::parse(cases[i].resolved_json)) {
+          StudyPoint& p = points[i];
+          p.status = 0;
+          if (j.contains("frf")) {
+            p.peak = j["frf"].value("peak_amplitude_m", 0.0);
+            p.peak_frequency = j["frf"].value("peak_frequency_hz", 0.0);
+            p.points = j["frf"].value("points", std::size_t{0});
+          }
+          p.seconds = j.value("point_seconds", 0.0);
+          p.cpu_seconds = j.value("point_cpu_seconds", 0.0);
+          ++reused;
+          continue;
+        }
+      } catch (const std::exception&) {
+        // unreadable: run the point again
+      }
+    }
+    std::filesystem::remove_all(dir, ec);
+    to_run.push_back(static_cast<int>(i));
+  }
+  if (ctx.resume)
+    log::info("study --resume: " + std::to_string(reused) + " of " + std::to_string(points.size()) +
+              " points reused (same case, status ok), " + std::to_string(to_run.size()) + " to run");
+  if (reused_points) *reused_points = reused;
+  const int workers = linalg::worker_count(ctx.threads, std::max<int>(1, static_cast<int>(to_run.size())));
+  log::info("study: " + std::to_string(to_run.size()) + " points on " + std::to_string(workers) + " workers");
   const bool verbose = log::verbose();
   log::set_verbose(false);  // points run quietly; one line each below
   std::mutex out;
   // Serial BLAS even with one worker: a point's cost is its thread's CPU time.
   linalg::SerialBlasScope serial;
-  linalg::parallel_for(static_cast<int>(points.size()), workers, [&](int i) {
+  linalg::parallel_for(static_cast<int>(to_run.size()), workers, [&](int k) {
     {
+      const int i = to_run[static_cast<std::size_t>(k)];
       Context pc;
       pc.config = cases[i];
       pc.out_dir = ctx.out_dir / points[i].folder;
@@ -97,6 +137,8 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
       rj["status"] = p.status == 0 ? "ok" : "failed";
       if (!p.message.empty()) rj["message"] = p.message;
       rj["case"] = nlohmann::json::parse(pc.config.resolved_json);
+      rj["point_seconds"] = p.seconds;
+      rj["point_cpu_seconds"] = p.cpu_seconds;
       try {
         io::write_file_atomic(pc.out_dir / "run.json", rj.dump(2) + "\n");
       } catch (const std::exception&) {
@@ -183,7 +225,8 @@ StudyOutcome run_convergence(Context& ctx, const CaseRunner& run_case) {
   log::info("study --convergence: " + std::to_string(knobs.size()) + " knobs, " + std::to_string(points.size()) +
             " runs");
   log::Stopwatch clock;
-  const int workers = run_points(ctx, cases, points, run_case);
+  int reused = 0;
+  const int workers = run_points(ctx, cases, points, run_case, &reused);
   ctx.report.stage("study", clock.seconds());
 
   std::ostringstream csv;
@@ -210,11 +253,8 @@ StudyOutcome run_convergence(Context& ctx, const CaseRunner& run_case) {
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());
-  ctx.report.section("study") = {{"convergence", true},
-                                 {"runs", points.size()},
-                                 {"knobs", knobs.size()},
-                                 {"failed_rows", failed},
-                                 {"workers", workers}};
+  ctx.report.section("study") = {{"convergence", true},   {"runs", points.size()}, {"knobs", knobs.size()},
+                                 {"failed_rows", failed}, {"workers", workers},    {"reused_points", reused}};
   // The mesh ladder: observed order and extrapolated peak (docs/contact_patches.md).
   for (std::size_t k = 0; k < knobs.size(); ++k) {
     if (knobs[k].key != "geometry.mesh_size") continue;
@@ -321,9 +361,9 @@ StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
   log::info("study: sampled, " + std::to_string(n) + " points (" + io::to_string(st.method) + ", seed " +
             std::to_string(st.seed) + "), " + std::to_string(n - static_cast<int>(runnable.size())) +
             " refused by the case's rules");
-  int workers = 0;
+  int workers = 0, reused = 0;
   if (!runnable.empty()) {
-    workers = run_points(ctx, cases, runnable, run_case);
+    workers = run_points(ctx, cases, runnable, run_case, &reused);
     for (std::size_t k = 0; k < runnable.size(); ++k) points[runnable_index[k]] = runnable[k];
   }
 
@@ -351,10 +391,11 @@ StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
   }
   io::write_file_atomic(ctx.out_dir / "study.csv", csv.str());
 
-  nlohmann::json j = {{"sampled", true},  {"points", n},
-                      {"failed", failed}, {"workers", workers},
-                      {"samples", n},     {"method", io::to_string(st.method)},
-                      {"seed", st.seed},  {"inputs", nlohmann::json::array()}};
+  nlohmann::json j = {{"sampled", true},        {"points", n},
+                      {"failed", failed},       {"workers", workers},
+                      {"samples", n},           {"method", io::to_string(st.method)},
+                      {"seed", st.seed},        {"inputs", nlohmann::json::array()},
+                      {"reused_points", reused}};
   for (std::size_t d = 0; d < st.sample.size(); ++d)
     j["inputs"].push_back({{"key", st.sample[d].key}, {"distribution", dist[d].describe()}});
   if (!peaks.empty()) {
@@ -398,9 +439,9 @@ StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
 
 }  // namespace
 
-StudyOutcome run_study(Context& ctx, const CaseRunner& run_case) {
+StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunner& run_forced) {
   if (ctx.convergence) return run_convergence(ctx, run_case);
-  if (!ctx.config.study.sample.empty()) return run_sampled(ctx, run_case);
+  if (!ctx.config.study.sample.empty()) return run_sampled(ctx, run_forced);
   const io::Case& base = ctx.config;
   if (base.study.vary.empty())
     throw InputError(base.locations.at("study.vary") +
@@ -446,7 +487,8 @@ StudyOutcome run_study(Context& ctx, const CaseRunner& run_case) {
     for (std::size_t i = 0; i < points.size(); ++i)
       if (uses[points[i].folder] > 1) points[i].folder += "__point" + std::to_string(i + 1);
   }
-  const int workers = run_points(ctx, cases, points, run_case);
+  int reused = 0;
+  const int workers = run_points(ctx, cases, points, run_case, &reused);
 
   std::ostringstream csv;
   for (const auto& [k, v] : points.front().values) csv << k << ",";
@@ -464,7 +506,8 @@ StudyOutcome run_study(Context& ctx, const CaseRunner& run_case) {
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "study.csv", csv.str());
-  ctx.report.section("study") = {{"points", points.size()}, {"failed", failed}, {"workers", workers}};
+  ctx.report.section("study") = {
+      {"points", points.size()}, {"failed", failed}, {"workers", workers}, {"reused_points", reused}};
   StudyOutcome outcome;
   if (failed)
     outcome.warning =

@@ -30,9 +30,12 @@ struct StudyOutcome {
   std::string warning;  ///< empty: every point (row) ran; otherwise how many failed
 };
 
-/// The study of ctx.config (the vary grid, or the convergence study when ctx.convergence)
-/// into ctx.out_dir; the report's "study" section. Throws InputError for an empty or too
-/// large grid or a point whose values do not make a valid case.
-StudyOutcome run_study(Context& ctx, const CaseRunner& run_case);
+/// The study of ctx.config (the vary grid, the convergence study when ctx.convergence, or the
+/// sampled study of [study] sample) into ctx.out_dir; the report's "study" section. Sweep and
+/// convergence points run `run_case` (every stage of the case); the points of a sampled study,
+/// whose result is the forced response, run `run_forced` (the stages the forced response needs,
+/// not the Campbell diagram or the modes' output files of every sample). Throws InputError for
+/// an empty or too large grid or a sweep point whose values do not make a valid case.
+StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunner& run_forced);
 
 }  // namespace shroudsim::pipeline

@@ -3,14 +3,19 @@
 // puts one value in each stratum), the statistics in run.json are those of study.csv
 // (recomputed here independently), the same seed gives the same table, a drawn value the case
 // refuses is recorded with its reason while the other samples run, and bad sample tables exit 2
-// naming the key.
+// naming the key. `study --resume`: the finished points of a killed or earlier study are reused
+// when their case is the same, and only the others run.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli_runner.hpp"
@@ -193,6 +198,75 @@ sample = { "contact.friction_coefficient" = { distribution = "uniform", min = 0.
     EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(s.dir() / "results" / "sampled" / "study.csv"));
   }
+}
+
+std::map<std::string, std::vector<std::string>> without_seconds(std::map<std::string, std::vector<std::string>> t) {
+  t.erase("seconds");
+  return t;
+}
+
+TEST(CliSampled, ResumeReusesTheFinishedPointsOfTheSameCaseOnly) {
+  const Scratch s("resume_done");
+  s.write("case.toml", sampled_case(R"(vary = { "contact.friction_coefficient" = [0.1, 0.2, 0.3, 0.4] }
+)"));
+  ASSERT_EQ(s.run("study case.toml --quiet").status, 0);
+  const std::string before = slurp(s.dir() / "results" / "sampled" / "study.csv");
+  const CliResult again = s.run("study case.toml --quiet --resume");
+  ASSERT_EQ(again.status, 0) << again.err;
+  auto run = nlohmann::json::parse(slurp(s.dir() / "results" / "sampled" / "run.json"));
+  EXPECT_EQ(run["study"]["reused_points"].get<int>(), 4);
+  // Reused points keep their numbers and their recorded times: the same table.
+  EXPECT_EQ(slurp(s.dir() / "results" / "sampled" / "study.csv"), before);
+  // Another case (a tighter tolerance): no point is the same, every one runs again.
+  const CliResult other = s.run("study case.toml --quiet --resume --set hbm.tolerance=1e-9");
+  ASSERT_EQ(other.status, 0) << other.err;
+  run = nlohmann::json::parse(slurp(s.dir() / "results" / "sampled" / "run.json"));
+  EXPECT_EQ(run["study"]["reused_points"].get<int>(), 0);
+}
+
+TEST(CliSampled, AKilledStudyResumesWithOnlyItsMissingPoints) {
+  const Scratch s("resume_killed");
+  s.write("case.toml", sampled_case(R"(samples = 24
+sample = { "contact.friction_coefficient" = { distribution = "uniform", min = 0.05, max = 0.35 } }
+)"));
+  // The reference: the whole study in one go.
+  ASSERT_EQ(s.run("study case.toml --quiet --out full").status, 0);
+  // The same study killed once a few points are done (its staging folder names its pid).
+  std::thread run([&] { s.run("study case.toml --quiet --threads 1 --out r"); });
+  int pid = -1, done = 0;
+  for (int i = 0; i < 4000 && done < 3; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(s.dir(), ec)) {
+      const std::string n = e.path().filename().string();
+      if (n.rfind(".r.staging-", 0) != 0) continue;
+      pid = std::stoi(n.substr(11));
+      done = 0;
+      for (const auto& p : std::filesystem::directory_iterator(e.path(), ec))
+        done += std::filesystem::exists(p.path() / "run.json") ? 1 : 0;
+    }
+  }
+  ASSERT_GT(pid, 0);
+  ::kill(pid, SIGKILL);
+  run.join();
+  ASSERT_FALSE(std::filesystem::exists(s.dir() / "r" / "study.csv")) << "killed before the end";
+  int finished = 0;
+  for (const auto& e : std::filesystem::directory_iterator(s.dir())) {
+    if (e.path().filename().string().rfind(".r.staging-", 0) != 0) continue;
+    for (const auto& p : std::filesystem::directory_iterator(e.path()))
+      finished += std::filesystem::exists(p.path() / "run.json") ? 1 : 0;
+  }
+  ASSERT_GE(finished, 3);
+  ASSERT_LT(finished, 24) << "the study was not killed mid-way";
+  const CliResult resumed = s.run("study case.toml --quiet --resume --out r");
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  const auto run_json = nlohmann::json::parse(slurp(s.dir() / "r" / "run.json"));
+  EXPECT_EQ(run_json["study"]["reused_points"].get<int>(), finished);
+  // The resumed study is the whole study: every sample, the same numbers.
+  EXPECT_EQ(without_seconds(columns(slurp(s.dir() / "r" / "study.csv"))),
+            without_seconds(columns(slurp(s.dir() / "full" / "study.csv"))));
+  for (const auto& e : std::filesystem::directory_iterator(s.dir()))
+    EXPECT_EQ(e.path().filename().string().find(".staging-"), std::string::npos) << e.path();
 }
 
 }  // namespace
