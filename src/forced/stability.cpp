@@ -23,7 +23,7 @@ constexpr double kKindTolerance = 0.05;
 double FloquetResult::spectral_radius(double frequency_hz) const { return std::exp(max_real / frequency_hz); }
 
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
-                                ExponentSelection selection) {
+                                ExponentSelection selection, int max_size) {
   FloquetResult out;
   const frf::LinearPart& linear = equations.linear_part();
   const hbm::HarmonicLayout& layout = equations.pair_layout();
@@ -34,14 +34,25 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   // The second-order form of every harmonic 0..H (k < 0: the conjugate).
   std::vector<frf::SecondOrderForm> forms(static_cast<std::size_t>(h + 1));
   for (int n = 0; n <= h; ++n)
-    if (!linear.second_order_form(n, forms[static_cast<std::size_t>(n)])) return out;
-  out.available = true;
+    if (!linear.second_order_form(n, forms[static_cast<std::size_t>(n)])) {
+      out.reason =
+          "the linear part has no second-order form: Hill's method is implemented for lumped models "
+          "(docs/physics.md section 9)";
+      return out;
+    }
   auto form = [&](int k) -> const frf::SecondOrderForm& { return forms[static_cast<std::size_t>(std::abs(k))]; };
   std::vector<Eigen::Index> offset(static_cast<std::size_t>(nk + 1), 0);
   for (int k = -h; k <= h; ++k)
     offset[static_cast<std::size_t>(k + h + 1)] = offset[static_cast<std::size_t>(k + h)] + form(k).M.rows();
   const Eigen::Index s = offset.back();
   if (s == 0) throw NumericalError("no modes for the Floquet analysis");
+  out.hill_size = static_cast<int>(2 * s);
+  if (out.hill_size > max_size) {
+    out.reason = "the Hill eigenproblem would be " + std::to_string(out.hill_size) + " wide (2 DOFs (2H + 1)), above " +
+                 std::to_string(max_size) + " (forced/stability.hpp kMaxHillSize)";
+    return out;
+  }
+  out.available = true;
 
   // D in exponential coefficients: index (k + H) c + 3 p + d. Per pair and direction, the real
   // coefficients [c0 | c1 s1 | ...] map to X_0 = c0, X_n = (c_n - i s_n) / 2,
@@ -106,7 +117,6 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   companion.topRightCorner(s, s).setIdentity();
   companion.bottomLeftCorner(s, s) = -a2_lu.solve(a0);
   companion.bottomRightCorner(s, s) = -a2_lu.solve(a1);
-  out.hill_size = static_cast<int>(2 * s);
   if (!companion.allFinite()) throw NumericalError("the Hill matrix is not finite");
   const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> solver(companion, selection == ExponentSelection::symmetry);
   if (solver.info() != Eigen::Success) throw NumericalError("the Hill eigenproblem did not converge");

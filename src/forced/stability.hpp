@@ -36,10 +36,16 @@ namespace shroudsim::forced {
 /// the slowest decay of a model with 1e-6 modal damping (-1e-6) well above it.
 constexpr double kNeutralTolerance = 1e-9;
 
+/// The largest companion eigenproblem solved per point (dense, O(size^3)): about 0.4 s per
+/// point at 400 on this project's 2-core machines; larger problems are not analysed (the
+/// result says why) rather than multiplying the forced response's time.
+constexpr int kMaxHillSize = 400;
+
 enum class ExponentSelection { symmetry, imaginary };
 
 struct FloquetResult {
-  bool available = false;  ///< false: the linear part has no second-order form
+  bool available = false;  ///< false: no second-order form, or the problem exceeds max_size
+  std::string reason;      ///< why not available
   bool stable = true;
   /// The selected Floquet exponents lambda [1/s], by decreasing real part.
   std::vector<std::complex<double>> exponents;
@@ -51,7 +57,7 @@ struct FloquetResult {
 
 /// The Floquet exponents of the solution w of `equations` at frequency f [Hz].
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
-                                ExponentSelection selection = ExponentSelection::symmetry);
+                                ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize);
 
 /// Where the stability changes between two neighbouring points of a branch.
 struct StabilityChange {

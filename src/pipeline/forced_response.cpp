@@ -95,10 +95,8 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   const bool any = std::any_of(out.begin(), out.end(), [](const auto& f) { return f.available; });
   s["available"] = any || failed > 0;
   if (!any && failed == 0) {
-    s["reason"] =
-        "the linear part has no second-order form: Hill's method is implemented for lumped models "
-        "(docs/physics.md section 9)";
-    log::info("frf: stability not analysed (Hill's method is implemented for lumped models)");
+    s["reason"] = out.empty() ? std::string("no points") : out.front().reason;
+    log::info("frf: stability not analysed: " + s["reason"].get<std::string>());
     return out;
   }
   s["method"] = "hill";

@@ -185,6 +185,18 @@ TEST(Stability, AStuckContactHasTheDampedEigenvaluesOfTheStuckSystemAtAnyTimeSca
   }
 }
 
+TEST(Stability, AProblemAboveTheSizeLimitIsNotAnalysedAndSaysWhy) {
+  Lumped l = stuck_chain(1.0);
+  hbm::ContactEvaluator ev(l.options, l.model.pairs);
+  ReducedEquations eq(*l.model.linear, ev);
+  const double f = 1.1 / (2 * kPi);
+  const FloquetResult r = floquet_exponents(eq, eq.stuck_solution(f), f, ExponentSelection::symmetry, 40);
+  EXPECT_FALSE(r.available);
+  EXPECT_EQ(r.hill_size, 44);  // 2 DOFs x 11 harmonics x 2
+  EXPECT_NE(r.reason.find("44 wide"), std::string::npos) << r.reason;
+  EXPECT_TRUE(r.exponents.empty());
+}
+
 TEST(Stability, HillAgreesWithShootingOnAHardeningGapOscillatorWithAFoldPair) {
   Lumped l = gap_oscillator();
   hbm::ContactEvaluator ev(l.options, l.model.pairs);
