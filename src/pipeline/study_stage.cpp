@@ -324,10 +324,7 @@ StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
   const io::Case& base = ctx.config;
   const io::StudySection& st = base.study;
   const int n = st.samples, dims = static_cast<int>(st.sample.size());
-  const study::SampleMethod method = st.method == io::SampleMethod::random  ? study::SampleMethod::random
-                                     : st.method == io::SampleMethod::sobol ? study::SampleMethod::sobol
-                                                                            : study::SampleMethod::latin_hypercube;
-  const auto unit = study::unit_samples(method, n, dims, static_cast<std::uint64_t>(st.seed));
+  const auto unit = study::unit_samples(st.method, n, dims, static_cast<std::uint64_t>(st.seed));
   std::vector<study::Distribution> dist;
   for (const auto& in : st.sample) dist.push_back(distribution_of(in));
   std::vector<std::vector<double>> drawn(static_cast<std::size_t>(n));

@@ -11,15 +11,6 @@
 
 namespace shroudsim::study {
 
-std::string to_string(SampleMethod m) {
-  switch (m) {
-    case SampleMethod::random: return "random";
-    case SampleMethod::latin_hypercube: return "latin_hypercube";
-    case SampleMethod::sobol: return "sobol";
-  }
-  return "random";
-}
-
 double normal_quantile(double u) { return std::sqrt(2.0) * boost::math::erf_inv(2.0 * u - 1.0); }
 
 double Distribution::quantile(double u) const {

@@ -9,10 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "io/case.hpp"
+
 namespace shroudsim::study {
 
-enum class SampleMethod { random, latin_hypercube, sobol };
-std::string to_string(SampleMethod m);
+/// The case's study.method (one enum for the case file and the sampler).
+using SampleMethod = io::SampleMethod;
+using io::to_string;
 
 /// One uncertain input: uniform on [a, b], normal with mean a and standard deviation b, or
 /// lognormal with median a and standard deviation b of its logarithm.
