@@ -19,6 +19,7 @@ packages=(
   libgmsh-dev gmsh
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libboost-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-meshio python3-matplotlib
   python3-dev pybind11-dev python3-pybind11
 )

@@ -15,10 +15,12 @@
 #include "app/context.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "distributed/task_pool.hpp"
 #include "io/case.hpp"
 #include "io/output.hpp"
 #include "io/results_folder.hpp"
 #include "io/schema.hpp"
+#include "pipeline/study_stage.hpp"
 
 namespace shroudsim::app {
 namespace {
@@ -186,20 +188,53 @@ int run_cli(int argc, char** argv) {
     return 2;
   }
   const CommonOptions& o = options[chosen];
-  log::set_verbose(!o.quiet);
-  log::set_detailed(o.verbose && !o.quiet);
+  const std::string command = subs[chosen].name;
+  // Under an MPI launcher (`mpirun -n K`): only `study` shares its work; rank 0 reads the
+  // case, owns the results folder and prints, the other ranks serve its points
+  // (pipeline::serve_study) in its staging folder.
+  distributed::World& world = distributed::world();
+  const bool root = world.rank() == 0;
+  if (world.distributed() && command != "study") {
+    if (root)
+      std::cerr << "shroudsim: error: " << command << " runs as one process; only `study` shares its points over "
+                << world.size() << " MPI ranks (run it without mpirun)\n";
+    return 2;
+  }
+  log::set_verbose(!o.quiet && root);
+  log::set_detailed(o.verbose && !o.quiet && root);
   log::Stopwatch clock;
 
   Context ctx;
+  std::string error;
   try {
     ctx.config = io::load_case(o.case_file, o.sets);
   } catch (const InputError& e) {
-    std::cerr << "shroudsim: error: " << e.what() << "\n";
-    return 2;
+    error = e.what();
   } catch (const std::exception& e) {
-    std::cerr << "shroudsim: error: " << o.case_file << ": " << e.what() << "\n";
+    error = o.case_file + ": " + e.what();
+  }
+  if (!world.all_ok(error.empty())) {
+    // Rank 0 says why; another rank only when rank 0 could read the case (a file system
+    // that differs between nodes).
+    const bool root_ok = world.broadcast(error.empty() ? "ok" : "") == "ok";
+    if (!error.empty() && (root || root_ok))
+      std::cerr << "shroudsim: error: " << (root ? "" : "rank " + std::to_string(world.rank()) + ": ") << error << "\n";
     return 2;
   }
+  const int threads = o.threads > 0 ? o.threads : world.distributed() ? world.default_threads() : 0;
+  if (!root) {
+    // A serving rank: the points go into rank 0's staging folder ("" when rank 0 refused it).
+    const std::string staging = world.broadcast("");
+    if (staging.empty()) return 2;
+    return pipeline::serve_study(threads, cmd_run, cmd_frf);
+  }
+  // Rank 0 releases the serving ranks whatever happens below, with its exit status.
+  int status = 1;
+  struct Release {
+    distributed::World& world;
+    const int& status;
+    ~Release() { world.release(status); }
+  } release{world, status};
   // The results folder: checked and locked before any work, written through a staging
   // folder and replaced in one exchange at the end (io/results_folder.hpp).
   std::unique_ptr<io::ResultsFolder> folder;
@@ -208,20 +243,23 @@ int run_cli(int argc, char** argv) {
         o.out.empty() ? std::filesystem::path("results") / ctx.config.name : std::filesystem::path(o.out),
         o.out.empty() ? "results folder (results/<name>)" : "--out", o.resume);
   } catch (const InputError& e) {
+    world.broadcast("");
     std::cerr << "shroudsim: error: " << e.what() << "\n";
-    return 2;
+    return status = 2;
   }
+  world.broadcast(std::filesystem::absolute(folder->staging()).string());
+  if (world.distributed())
+    log::info("study: " + std::to_string(world.size()) + " MPI ranks, " + std::to_string(threads) +
+              " workers each unless --threads says otherwise per rank");
   ctx.out_dir = folder->staging();
-  ctx.threads = o.threads;
+  ctx.threads = threads;
   ctx.overrides = o.sets;
   ctx.convergence = o.convergence;
   ctx.resume = o.resume;
   if (o.resume)
     log::info("study --resume: " + (folder->resumed_from().empty() ? std::string("nothing to resume from")
                                                                    : "from " + folder->resumed_from()));
-  const std::string command = subs[chosen].name;
 
-  int status = 1;
   std::string state = "failed", message;
   try {
     status = subs[chosen].run(ctx);

@@ -3,8 +3,11 @@
 #include <iostream>
 
 #include "app/cli.hpp"
+#include "distributed/task_pool.hpp"
 
 int main(int argc, char** argv) {
+  // MPI_Init under an MPI launcher (`mpirun -n K shroudsim study`), MPI_Finalize at the end.
+  shroudsim::distributed::Session mpi(&argc, &argv);
   try {
     return shroudsim::app::run_cli(argc, argv);
   } catch (const std::exception& e) {

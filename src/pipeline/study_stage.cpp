@@ -2,7 +2,6 @@
 #include "pipeline/study_stage.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <ctime>
 #include <filesystem>
@@ -10,13 +9,12 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <thread>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "distributed/task_pool.hpp"
 #include "io/output.hpp"
 #include "linalg/parallel.hpp"
 #include "study/curves.hpp"
@@ -56,11 +54,82 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-/// Runs every point (the case `cases[i]` into <out>/<points[i].folder>) on --threads workers,
-/// quietly, one line each; fills status, message, peak, points and seconds. Returns the
-/// number of workers used; reused_points: how many finished points --resume reused.
+/// The command's two case runners: `run` (every stage of the case: sweep and convergence
+/// points) and `frf` (the forced response only: sampled points).
+struct Runners {
+  const CaseRunner& run_case;
+  const CaseRunner& run_forced;
+};
+
+/// A point's task for the work pool (distributed/task_pool.hpp): what any rank needs to run
+/// it. Paths are absolute: a serving rank may start elsewhere (same file system).
+distributed::Json point_task(const Context& ctx, const StudyPoint& p, bool forced) {
+  std::vector<std::string> sets = ctx.overrides;
+  for (const auto& [k, v] : p.values) sets.push_back(k + "=" + v);
+  return {{"case_file", std::filesystem::absolute(ctx.config.file).string()},
+          {"sets", sets},
+          {"dir", std::filesystem::absolute(ctx.out_dir / p.folder).string()},
+          {"forced", forced}};
+}
+
+/// Runs one point's task on this rank (quietly, one thread) into its folder, writes the
+/// folder's run.json (the point's report, status, case and cost) and returns the result that
+/// run_points reads back. Never throws: a failure is a status and a message.
+distributed::Json run_point(const distributed::Json& task, const Runners& runners) {
+  Context pc;
+  pc.out_dir = task.at("dir").get<std::string>();
+  pc.threads = 1;
+  pc.plots = false;
+  log::Stopwatch clock;
+  const double cpu0 = thread_cpu_seconds();
+  int status = 1;
+  std::string message;
+  bool loaded = false;
+  try {
+    pc.config = io::load_case(task.at("case_file").get<std::string>(), task.at("sets").get<std::vector<std::string>>());
+    loaded = true;
+    status = (task.at("forced").get<bool>() ? runners.run_forced : runners.run_case)(pc);
+  } catch (const InputError& e) {
+    status = 2, message = e.what();
+  } catch (const NumericalError& e) {
+    status = 3, message = e.what();
+  } catch (const std::exception& e) {
+    status = 1, message = e.what();
+  }
+  distributed::Json r = {{"status", status},
+                         {"message", message},
+                         {"seconds", clock.seconds()},
+                         {"cpu_seconds", thread_cpu_seconds() - cpu0},
+                         {"rank", distributed::world().rank()},
+                         {"peak", 0.0},
+                         {"peak_frequency", 0.0},
+                         {"points", 0}};
+  const auto& j = pc.report.json();
+  if (j.contains("frf")) {
+    r["peak"] = j["frf"].value("peak_amplitude_m", 0.0);
+    r["peak_frequency"] = j["frf"].value("peak_frequency_hz", 0.0);
+    r["points"] = j["frf"].value("points", std::size_t{0});
+  }
+  nlohmann::json rj = j;
+  rj["status"] = status == 0 ? "ok" : "failed";
+  if (!message.empty()) rj["message"] = message;
+  if (loaded) rj["case"] = nlohmann::json::parse(pc.config.resolved_json);
+  rj["point_seconds"] = r["seconds"];
+  rj["point_cpu_seconds"] = r["cpu_seconds"];
+  try {
+    io::write_file_atomic(pc.out_dir / "run.json", rj.dump(2) + "\n");
+  } catch (const std::exception&) {
+  }
+  return r;
+}
+
+/// Runs every point (the case `cases[i]` into <out>/<points[i].folder>) on --threads workers
+/// here and, under `mpirun -n K`, on the workers of every rank (distributed/task_pool.hpp),
+/// quietly, one line each; fills status, message, peak, points and seconds. The first point
+/// runs alone: it fills the mesh and mode caches the others read. Returns the number of
+/// workers used; reused_points: how many finished points --resume reused.
 int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<StudyPoint>& points,
-               const CaseRunner& run_case, int* reused_points = nullptr) {
+               const Runners& runners, bool forced, int* reused_points = nullptr) {
   // --resume: a point whose folder holds a run.json of status ok for the same case (its
   // fingerprint: the resolved case, every key) is reused as it is; any other folder of a point
   // (a failed point, a point killed half-written, a point of another case) is cleared and run.
@@ -98,61 +167,34 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
     log::info("study --resume: " + std::to_string(reused) + " of " + std::to_string(points.size()) +
               " points reused (same case, status ok), " + std::to_string(to_run.size()) + " to run");
   if (reused_points) *reused_points = reused;
-  const int workers = linalg::worker_count(ctx.threads, std::max<int>(1, static_cast<int>(to_run.size())));
-  log::info("study: " + std::to_string(to_run.size()) + " points on " + std::to_string(workers) + " workers");
+  const distributed::World& world = distributed::world();
+  const int threads = linalg::worker_count(ctx.threads, std::max<int>(1, static_cast<int>(to_run.size())));
+  log::info("study: " + std::to_string(to_run.size()) + " points on " + std::to_string(threads) + " workers" +
+            (world.distributed() ? " here and the workers of " + std::to_string(world.size() - 1) + " more ranks"
+                                 : std::string()));
+  std::vector<distributed::Json> tasks;
+  for (const int i : to_run) tasks.push_back(point_task(ctx, points[static_cast<std::size_t>(i)], forced));
   const bool verbose = log::verbose();
   log::set_verbose(false);  // points run quietly; one line each below
-  std::mutex out;
-  // Serial BLAS even with one worker: a point's cost is its thread's CPU time.
-  linalg::SerialBlasScope serial;
-  linalg::parallel_for(static_cast<int>(to_run.size()), workers, [&](int k) {
-    {
-      const int i = to_run[static_cast<std::size_t>(k)];
-      Context pc;
-      pc.config = cases[i];
-      pc.out_dir = ctx.out_dir / points[i].folder;
-      pc.threads = 1;
-      pc.plots = false;
-      log::Stopwatch clock;
-      const double cpu0 = thread_cpu_seconds();
-      StudyPoint& p = points[i];
-      try {
-        p.status = run_case(pc);
-      } catch (const InputError& e) {
-        p.status = 2, p.message = e.what();
-      } catch (const NumericalError& e) {
-        p.status = 3, p.message = e.what();
-      } catch (const std::exception& e) {
-        p.status = 1, p.message = e.what();
-      }
-      p.seconds = clock.seconds();
-      p.cpu_seconds = thread_cpu_seconds() - cpu0;
-      const auto& j = pc.report.json();
-      if (j.contains("frf")) {
-        p.peak = j["frf"].value("peak_amplitude_m", 0.0);
-        p.peak_frequency = j["frf"].value("peak_frequency_hz", 0.0);
-        p.points = j["frf"].value("points", std::size_t{0});
-      }
-      nlohmann::json rj = j;
-      rj["status"] = p.status == 0 ? "ok" : "failed";
-      if (!p.message.empty()) rj["message"] = p.message;
-      rj["case"] = nlohmann::json::parse(pc.config.resolved_json);
-      rj["point_seconds"] = p.seconds;
-      rj["point_cpu_seconds"] = p.cpu_seconds;
-      try {
-        io::write_file_atomic(pc.out_dir / "run.json", rj.dump(2) + "\n");
-      } catch (const std::exception&) {
-      }
-      std::lock_guard<std::mutex> lock(out);
-      if (verbose) {
+  const int workers = distributed::run_tasks(
+      tasks, {threads, /*first_alone=*/true}, [&](const distributed::Json& t) { return run_point(t, runners); },
+      [&](std::size_t k, const distributed::Json& r) {
+        StudyPoint& p = points[static_cast<std::size_t>(to_run[k])];
+        p.status = r.at("status").get<int>();
+        p.message = r.at("message").get<std::string>();
+        p.seconds = r.at("seconds").get<double>();
+        p.cpu_seconds = r.at("cpu_seconds").get<double>();
+        p.peak = r.at("peak").get<double>();
+        p.peak_frequency = r.at("peak_frequency").get<double>();
+        p.points = r.at("points").get<std::size_t>();
+        if (!verbose) return;
         std::ostringstream s;
         s << "shroudsim: study: " << p.folder << ": " << (p.status == 0 ? "ok" : "failed (" + p.message + ")")
           << ", peak " << std::scientific << std::setprecision(4) << p.peak << " m at " << std::defaultfloat
-          << std::setprecision(6) << p.peak_frequency << " Hz, " << std::setprecision(3) << p.seconds << " s\n";
-        std::cerr << s.str();
-      }
-    }
-  });
+          << std::setprecision(6) << p.peak_frequency << " Hz, " << std::setprecision(3) << p.seconds << " s";
+        if (world.distributed()) s << " (rank " << r.at("rank").get<int>() << ")";
+        std::cerr << s.str() << "\n";
+      });
   log::set_verbose(verbose);
   return workers;
 }
@@ -163,7 +205,7 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
 /// its curve and the reference's (the largest relative change at any resonance peak of the
 /// range) and peaks_shift_hz (the largest shift of such a peak); its cost is its wall time (a run
 /// that has to build a new mesh and its modes pays for them). -> trade.csv, trade.png.
-StudyOutcome run_convergence(Context& ctx, const CaseRunner& run_case) {
+StudyOutcome run_convergence(Context& ctx, const Runners& runners) {
   const io::Case& c = ctx.config;
   auto num = [](double v) { return io::format_number(v); };
   const std::vector<study::Knob> knobs = study::convergence_knobs(c);
@@ -226,7 +268,7 @@ StudyOutcome run_convergence(Context& ctx, const CaseRunner& run_case) {
             " runs");
   log::Stopwatch clock;
   int reused = 0;
-  const int workers = run_points(ctx, cases, points, run_case, &reused);
+  const int workers = run_points(ctx, cases, points, runners, /*forced=*/false, &reused);
   ctx.report.stage("study", clock.seconds());
 
   std::ostringstream csv;
@@ -253,8 +295,13 @@ StudyOutcome run_convergence(Context& ctx, const CaseRunner& run_case) {
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());
-  ctx.report.section("study") = {{"convergence", true},   {"runs", points.size()}, {"knobs", knobs.size()},
-                                 {"failed_rows", failed}, {"workers", workers},    {"reused_points", reused}};
+  ctx.report.section("study") = {{"convergence", true},
+                                 {"runs", points.size()},
+                                 {"knobs", knobs.size()},
+                                 {"failed_rows", failed},
+                                 {"workers", workers},
+                                 {"reused_points", reused},
+                                 {"ranks", distributed::world().size()}};
   // The mesh ladder: observed order and extrapolated peak (docs/contact_patches.md).
   for (std::size_t k = 0; k < knobs.size(); ++k) {
     if (knobs[k].key != "geometry.mesh_size") continue;
@@ -320,7 +367,7 @@ nlohmann::json statistics_json(const study::SampleStatistics& s) {
 /// and the others run. -> study.csv (one row per sample), run.json study.statistics (peak
 /// amplitude and frequency: mean, std, percentiles; the exceedance of study.threshold_m with its
 /// 95 % Wilson interval; Spearman's rank correlation of each input with both).
-StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
+StudyOutcome run_sampled(Context& ctx, const Runners& runners) {
   const io::Case& base = ctx.config;
   const io::StudySection& st = base.study;
   const int n = st.samples, dims = static_cast<int>(st.sample.size());
@@ -360,7 +407,7 @@ StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
             " refused by the case's rules");
   int workers = 0, reused = 0;
   if (!runnable.empty()) {
-    workers = run_points(ctx, cases, runnable, run_case, &reused);
+    workers = run_points(ctx, cases, runnable, runners, /*forced=*/true, &reused);
     for (std::size_t k = 0; k < runnable.size(); ++k) points[runnable_index[k]] = runnable[k];
   }
 
@@ -388,11 +435,16 @@ StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
   }
   io::write_file_atomic(ctx.out_dir / "study.csv", csv.str());
 
-  nlohmann::json j = {{"sampled", true},        {"points", n},
-                      {"failed", failed},       {"workers", workers},
-                      {"samples", n},           {"method", io::to_string(st.method)},
-                      {"seed", st.seed},        {"inputs", nlohmann::json::array()},
-                      {"reused_points", reused}};
+  nlohmann::json j = {{"sampled", true},
+                      {"points", n},
+                      {"failed", failed},
+                      {"workers", workers},
+                      {"samples", n},
+                      {"method", io::to_string(st.method)},
+                      {"seed", st.seed},
+                      {"inputs", nlohmann::json::array()},
+                      {"reused_points", reused},
+                      {"ranks", distributed::world().size()}};
   for (std::size_t d = 0; d < st.sample.size(); ++d)
     j["inputs"].push_back({{"key", st.sample[d].key}, {"distribution", dist[d].describe()}});
   if (!peaks.empty()) {
@@ -437,8 +489,9 @@ StudyOutcome run_sampled(Context& ctx, const CaseRunner& run_case) {
 }  // namespace
 
 StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunner& run_forced) {
-  if (ctx.convergence) return run_convergence(ctx, run_case);
-  if (!ctx.config.study.sample.empty()) return run_sampled(ctx, run_forced);
+  const Runners runners{run_case, run_forced};
+  if (ctx.convergence) return run_convergence(ctx, runners);
+  if (!ctx.config.study.sample.empty()) return run_sampled(ctx, runners);
   const io::Case& base = ctx.config;
   if (base.study.vary.empty())
     throw InputError(base.locations.at("study.vary") +
@@ -485,7 +538,7 @@ StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunne
       if (uses[points[i].folder] > 1) points[i].folder += "__point" + std::to_string(i + 1);
   }
   int reused = 0;
-  const int workers = run_points(ctx, cases, points, run_case, &reused);
+  const int workers = run_points(ctx, cases, points, runners, /*forced=*/false, &reused);
 
   std::ostringstream csv;
   for (const auto& [k, v] : points.front().values) csv << k << ",";
@@ -503,13 +556,21 @@ StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunne
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "study.csv", csv.str());
-  ctx.report.section("study") = {
-      {"points", points.size()}, {"failed", failed}, {"workers", workers}, {"reused_points", reused}};
+  ctx.report.section("study") = {{"points", points.size()},
+                                 {"failed", failed},
+                                 {"workers", workers},
+                                 {"reused_points", reused},
+                                 {"ranks", distributed::world().size()}};
   StudyOutcome outcome;
   if (failed)
     outcome.warning =
         std::to_string(failed) + " of " + std::to_string(points.size()) + " study points failed (see study.csv)";
   return outcome;
+}
+
+int serve_study(int threads, const CaseRunner& run_case, const CaseRunner& run_forced) {
+  const Runners runners{run_case, run_forced};
+  return distributed::serve(threads, [&](const distributed::Json& t) { return run_point(t, runners); });
 }
 
 }  // namespace shroudsim::pipeline

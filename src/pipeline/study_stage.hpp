@@ -13,6 +13,11 @@
 //     against its finest value -> trade.csv and, for the mesh ladder, the observed order and
 //     extrapolated peak in run.json "mesh_convergence" (docs/contact_patches.md).
 //
+// Under `mpirun -n K` (or srun) the points are shared with the other ranks of the job, which
+// run serve_study (distributed/task_pool.hpp): a worker that finishes takes the next point;
+// rank 0 writes the tables. The first point runs alone either way: it fills the mesh and
+// mode caches of <case dir>/.cache that the other points read.
+//
 // A failed point is recorded (status and reason in its folder's run.json and in the table)
 // and the study goes on; the caller exits 3 when any failed.
 #include <functional>
@@ -37,5 +42,10 @@ struct StudyOutcome {
 /// not the Campbell diagram or the modes' output files of every sample). Throws InputError for
 /// an empty or too large grid or a sweep point whose values do not make a valid case.
 StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunner& run_forced);
+
+/// A serving rank of `mpirun -n K shroudsim study` (rank > 0): runs the points rank 0 hands
+/// out, on `threads` workers, into their folders of rank 0's staging folder (a file system
+/// every rank sees), with the same runners; returns the exit status rank 0 released it with.
+int serve_study(int threads, const CaseRunner& run_case, const CaseRunner& run_forced);
 
 }  // namespace shroudsim::pipeline

@@ -54,10 +54,12 @@ class Scratch {
     return p;
   }
   /// `shroudsim ARGS` with the scratch folder as working directory.
-  CliResult run(const std::string& args) const {
+  CliResult run(const std::string& args) const { return run_command("'" SHROUDSIM_EXE "' " + args); }
+  /// A shell command line (e.g. a launcher in front of shroudsim) in the scratch folder.
+  CliResult run_command(const std::string& command) const {
     const auto out = dir_ / ".stdout", err = dir_ / ".stderr";
-    const std::string cmd = "cd '" + dir_.string() + "' && '" SHROUDSIM_EXE "' " + args + " >'" + out.string() +
-                            "' 2>'" + err.string() + "' </dev/null";
+    const std::string cmd =
+        "cd '" + dir_.string() + "' && " + command + " >'" + out.string() + "' 2>'" + err.string() + "' </dev/null";
     const int raw = std::system(cmd.c_str());
     CliResult r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
