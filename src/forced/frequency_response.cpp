@@ -221,6 +221,26 @@ void add_counts(continuation::Branch& to, const continuation::Branch& b) {
   to.residual_evaluations += b.residual_evaluations;
 }
 
+/// Whether every frequency between a and b lies between the lowest and the highest frequency
+/// of some piece (null pieces are skipped): each piece is one continuous path of solutions,
+/// so together they have a solution at every frequency of the range.
+bool extents_cover(const std::vector<const std::vector<continuation::BranchPoint>*>& pieces, double a, double b) {
+  std::vector<std::pair<double, double>> spans;
+  for (const auto* piece : pieces) {
+    if (!piece || piece->empty()) continue;
+    double lo = piece->front().lambda, hi = lo;
+    for (const auto& p : *piece) lo = std::min(lo, p.lambda), hi = std::max(hi, p.lambda);
+    spans.emplace_back(lo, hi);
+  }
+  std::sort(spans.begin(), spans.end());
+  double covered = std::min(a, b);
+  for (const auto& [lo, hi] : spans) {
+    if (lo > covered) return false;
+    covered = std::max(covered, hi);
+  }
+  return covered >= std::max(a, b);
+}
+
 }  // namespace
 
 double free_motion_peak(const frf::LinearPart& linear, const ReducedEquations& equations, double f_start,
@@ -386,6 +406,22 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
                      second.message + "), and both ways from " + shortest(f_mid) +
                      " Hz into them (largest join distance " + shortest(out.join_distance) +
                      "; frf.csv column `piece`)");
+      } else if (!middle.empty() && extents_cover({&first.points, &second.points, &middle[0].points,
+                                                   middle.size() > 1 ? &middle[1].points : nullptr},
+                                                  ao.lambda_start, ao.lambda_end)) {
+        // The middle pieces turned back (or stopped) too, but every frequency of the range
+        // lies between the lowest and highest of some piece, each one continuous path of
+        // solutions: reported as pieces not shown to be one branch.
+        out.pieces_join = false;
+        std::string how;
+        for (std::size_t k = 0; k < middle.size(); ++k)
+          how += std::string(k == 0 ? "forward" : "; backward") + " from " + shortest(f_mid) +
+                 " Hz: " + (middle[k].message.empty() ? std::string("reached its end") : middle[k].message);
+        covered_with("the curve is " + std::to_string(2 + middle.size()) +
+                     " separate pieces that together cover the range but were not shown to be one branch: from " +
+                     shortest(ao.lambda_start) + " Hz to " + shortest(reached) + " Hz (" + first_message +
+                     "), back from " + shortest(ao.lambda_end) + " Hz to " + shortest(reached_back) + " Hz (" +
+                     second.message + "), " + how + " (frf.csv column `piece`)");
       } else if (second.status == continuation::BranchStatus::kLeftRange && covered) {
         // Both pieces turned back, but between them every frequency of the range has a
         // solution: reported as two separate branches.
