@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "core/error.hpp"
+#include "linalg/dense_eigen.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -118,14 +119,13 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   companion.bottomLeftCorner(s, s) = -a2_lu.solve(a0);
   companion.bottomRightCorner(s, s) = -a2_lu.solve(a1);
   if (!companion.allFinite()) throw NumericalError("the Hill matrix is not finite");
-  const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> solver(companion, selection == ExponentSelection::symmetry);
-  if (solver.info() != Eigen::Success) throw NumericalError("the Hill eigenproblem did not converge");
-  const Eigen::VectorXcd& mu = solver.eigenvalues();
+  const linalg::DenseEigen solver = linalg::dense_eigen(companion, selection == ExponentSelection::symmetry);
+  const Eigen::VectorXcd& mu = solver.values;
 
   std::vector<Complex> chosen;
   if (selection == ExponentSelection::symmetry) {
     for (Eigen::Index j = 0; j < mu.size(); ++j) {
-      const auto q = solver.eigenvectors().col(j).head(s);
+      const auto q = solver.vectors.col(j).head(s);
       double total = 0.0, moment = 0.0;
       for (int k = -h; k <= h; ++k) {
         const Eigen::Index o = offset[static_cast<std::size_t>(k + h)];

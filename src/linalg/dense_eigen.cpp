@@ -1,0 +1,49 @@
+// LAPACK zgeev: see dense_eigen.hpp.
+#include "linalg/dense_eigen.hpp"
+
+#include <algorithm>
+#include <complex>
+#include <stdexcept>
+#include <string>
+
+#include "core/error.hpp"
+
+extern "C" {
+// Fortran LAPACK (gfortran calling convention: trailing hidden lengths of the character args).
+void zgeev_(const char* jobvl, const char* jobvr, const int* n, std::complex<double>* a, const int* lda,
+            std::complex<double>* w, std::complex<double>* vl, const int* ldvl, std::complex<double>* vr,
+            const int* ldvr, std::complex<double>* work, const int* lwork, double* rwork, int* info, std::size_t,
+            std::size_t);
+}
+
+namespace shroudsim::linalg {
+
+DenseEigen dense_eigen(const Eigen::MatrixXcd& a, bool with_vectors) {
+  if (a.rows() != a.cols()) throw std::invalid_argument("dense_eigen: the matrix is not square");
+  DenseEigen out;
+  const int n = static_cast<int>(a.rows());
+  out.values.resize(n);
+  if (n == 0) return out;
+  Eigen::MatrixXcd work_a = a;  // overwritten by zgeev
+  if (with_vectors) out.vectors.resize(n, n);
+  const char jobvl = 'N', jobvr = with_vectors ? 'V' : 'N';
+  const int one = 1, ldvr = with_vectors ? n : 1;
+  std::complex<double> dummy;
+  std::complex<double>* vr = with_vectors ? out.vectors.data() : &dummy;
+  Eigen::VectorXd rwork(2 * n);
+  int info = 0, lwork = -1;
+  std::complex<double> query;
+  zgeev_(&jobvl, &jobvr, &n, work_a.data(), &n, out.values.data(), &dummy, &one, vr, &ldvr, &query, &lwork,
+         rwork.data(), &info, 1, 1);
+  lwork = std::max(1, static_cast<int>(query.real()));
+  Eigen::VectorXcd work(lwork);
+  zgeev_(&jobvl, &jobvr, &n, work_a.data(), &n, out.values.data(), &dummy, &one, vr, &ldvr, work.data(), &lwork,
+         rwork.data(), &info, 1, 1);
+  if (info > 0)
+    throw NumericalError("the dense eigenproblem (LAPACK zgeev, size " + std::to_string(n) +
+                         ") did not converge: " + std::to_string(info) + " eigenvalues missing");
+  if (info < 0) throw std::invalid_argument("dense_eigen: zgeev argument " + std::to_string(-info) + " is invalid");
+  return out;
+}
+
+}  // namespace shroudsim::linalg
