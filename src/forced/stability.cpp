@@ -1,10 +1,10 @@
 #include "forced/stability.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "core/error.hpp"
 #include "linalg/dense_eigen.hpp"
@@ -15,10 +15,69 @@ using Complex = std::complex<double>;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 // Half a harmonic: the symmetric copy's eigenvector centroid lies within it.
 constexpr double kCentroidHalfWidth = 0.5;
+// The Hill operator in the real harmonic coordinates is real; its transform from the
+// exponential form is taken as real when the imaginary parts are round-off of this size
+// relative to the largest entry (they are exact zeros up to the products' rounding).
+constexpr double kRealFormTolerance = 1e-10;
 // stability_changes: a critical exponent whose imaginary part is within this many w of 0 (or
 // of w / 2) is a real crossing (or a period doubling); the companion eigenvalues of a real
 // exponent carry an imaginary part of round-off size only.
 constexpr double kKindTolerance = 0.05;
+
+/// The eigenvalues (and eigenvectors, in exponential coordinates) of the Hill companion
+/// matrix, given in exponential coordinates (blocks k = -H..H at offset[k + H], in both halves
+/// [q; mu q]). The same operator in the real coordinates of the harmonic balance (X_0; c_n, s_n
+/// with X_n = (c_n - i s_n) / 2, X_-n = (c_n + i s_n) / 2) is real: there LAPACK's dgeev costs
+/// about a quarter of zgeev on the complex form. Falls back to the complex form when the
+/// transformed matrix is not real to round-off.
+linalg::DenseEigen hill_eigen(const Eigen::MatrixXcd& companion, const std::vector<Eigen::Index>& offset, int h,
+                              bool with_vectors) {
+  const Eigen::Index s = offset.back(), n2 = 2 * s;
+  // Index triples per harmonic n >= 1 and local DOF j: (X_n, X_-n) -> (c_n, s_n); n = 0 maps 1:1.
+  struct Pair {
+    Eigen::Index xp, xm, rc, rs;
+  };
+  std::vector<Pair> pairs;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> zero;  // (X_0, r_0)
+  Eigen::Index r = 0;
+  for (Eigen::Index half = 0; half < 2; ++half) {
+    const Eigen::Index base = half * s;
+    const Eigen::Index m0 = offset[static_cast<std::size_t>(h + 1)] - offset[static_cast<std::size_t>(h)];
+    for (Eigen::Index j = 0; j < m0; ++j) zero.emplace_back(base + offset[static_cast<std::size_t>(h)] + j, r++);
+    for (int n = 1; n <= h; ++n) {
+      const Eigen::Index op = offset[static_cast<std::size_t>(h + n)], om = offset[static_cast<std::size_t>(h - n)];
+      const Eigen::Index m = offset[static_cast<std::size_t>(h + n + 1)] - op;
+      for (Eigen::Index j = 0; j < m; ++j, r += 2) pairs.push_back({base + op + j, base + om + j, r, r + 1});
+    }
+  }
+  const Complex i1(0.0, 1.0);
+  // B = C S (columns), then R = S^-1 B (rows).
+  Eigen::MatrixXcd b(n2, n2);
+  for (const auto& [x, rr] : zero) b.col(rr) = companion.col(x);
+  for (const Pair& p : pairs) {
+    b.col(p.rc) = 0.5 * (companion.col(p.xp) + companion.col(p.xm));
+    b.col(p.rs) = 0.5 * i1 * (companion.col(p.xm) - companion.col(p.xp));
+  }
+  Eigen::MatrixXcd real_form(n2, n2);
+  for (const auto& [x, rr] : zero) real_form.row(rr) = b.row(x);
+  for (const Pair& p : pairs) {
+    real_form.row(p.rc) = b.row(p.xp) + b.row(p.xm);
+    real_form.row(p.rs) = i1 * (b.row(p.xp) - b.row(p.xm));
+  }
+  if (real_form.imag().cwiseAbs().maxCoeff() > kRealFormTolerance * real_form.real().cwiseAbs().maxCoeff())
+    return linalg::dense_eigen(companion, with_vectors);
+  linalg::DenseEigen out = linalg::dense_eigen(Eigen::MatrixXd(real_form.real()), with_vectors);
+  if (with_vectors) {
+    Eigen::MatrixXcd v(n2, n2);
+    for (const auto& [x, rr] : zero) v.row(x) = out.vectors.row(rr);
+    for (const Pair& p : pairs) {
+      v.row(p.xp) = 0.5 * (out.vectors.row(p.rc) - i1 * out.vectors.row(p.rs));
+      v.row(p.xm) = 0.5 * (out.vectors.row(p.rc) + i1 * out.vectors.row(p.rs));
+    }
+    out.vectors = std::move(v);
+  }
+  return out;
+}
 }  // namespace
 
 double FloquetResult::spectral_radius(double frequency_hz) const { return std::exp(max_real / frequency_hz); }
@@ -119,7 +178,8 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   companion.bottomLeftCorner(s, s) = -a2_lu.solve(a0);
   companion.bottomRightCorner(s, s) = -a2_lu.solve(a1);
   if (!companion.allFinite()) throw NumericalError("the Hill matrix is not finite");
-  const linalg::DenseEigen solver = linalg::dense_eigen(companion, selection == ExponentSelection::symmetry);
+  const bool vectors = selection == ExponentSelection::symmetry;
+  const linalg::DenseEigen solver = hill_eigen(companion, offset, h, vectors);
   const Eigen::VectorXcd& mu = solver.values;
 
   std::vector<Complex> chosen;

@@ -14,6 +14,9 @@ void zgeev_(const char* jobvl, const char* jobvr, const int* n, std::complex<dou
             std::complex<double>* w, std::complex<double>* vl, const int* ldvl, std::complex<double>* vr,
             const int* ldvr, std::complex<double>* work, const int* lwork, double* rwork, int* info, std::size_t,
             std::size_t);
+void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a, const int* lda, double* wr, double* wi,
+            double* vl, const int* ldvl, double* vr, const int* ldvr, double* work, const int* lwork, int* info,
+            std::size_t, std::size_t);
 }
 
 namespace shroudsim::linalg {
@@ -43,6 +46,50 @@ DenseEigen dense_eigen(const Eigen::MatrixXcd& a, bool with_vectors) {
     throw NumericalError("the dense eigenproblem (LAPACK zgeev, size " + std::to_string(n) +
                          ") did not converge: " + std::to_string(info) + " eigenvalues missing");
   if (info < 0) throw std::invalid_argument("dense_eigen: zgeev argument " + std::to_string(-info) + " is invalid");
+  return out;
+}
+
+DenseEigen dense_eigen(const Eigen::MatrixXd& a, bool with_vectors) {
+  if (a.rows() != a.cols()) throw std::invalid_argument("dense_eigen: the matrix is not square");
+  DenseEigen out;
+  const int n = static_cast<int>(a.rows());
+  out.values.resize(n);
+  if (n == 0) return out;
+  Eigen::MatrixXd work_a = a;  // overwritten by dgeev
+  Eigen::VectorXd wr(n), wi(n);
+  Eigen::MatrixXd vr_real;
+  if (with_vectors) vr_real.resize(n, n);
+  const char jobvl = 'N', jobvr = with_vectors ? 'V' : 'N';
+  const int one = 1, ldvr = with_vectors ? n : 1;
+  double dummy = 0.0, query = 0.0;
+  double* vr = with_vectors ? vr_real.data() : &dummy;
+  int info = 0, lwork = -1;
+  dgeev_(&jobvl, &jobvr, &n, work_a.data(), &n, wr.data(), wi.data(), &dummy, &one, vr, &ldvr, &query, &lwork, &info, 1,
+         1);
+  lwork = std::max(1, static_cast<int>(query));
+  Eigen::VectorXd work(lwork);
+  dgeev_(&jobvl, &jobvr, &n, work_a.data(), &n, wr.data(), wi.data(), &dummy, &one, vr, &ldvr, work.data(), &lwork,
+         &info, 1, 1);
+  if (info > 0)
+    throw NumericalError("the dense eigenproblem (LAPACK dgeev, size " + std::to_string(n) +
+                         ") did not converge: " + std::to_string(info) + " eigenvalues missing");
+  if (info < 0) throw std::invalid_argument("dense_eigen: dgeev argument " + std::to_string(-info) + " is invalid");
+  for (int j = 0; j < n; ++j) out.values[j] = {wr[j], wi[j]};
+  if (with_vectors) {
+    // dgeev stores a conjugate pair (wi[j] > 0, then its conjugate) as two real columns,
+    // v_j = re + i im and v_{j+1} = re - i im.
+    out.vectors.resize(n, n);
+    for (int j = 0; j < n; ++j) {
+      if (wi[j] != 0.0 && j + 1 < n) {
+        out.vectors.col(j) = vr_real.col(j).cast<std::complex<double>>() +
+                             std::complex<double>(0.0, 1.0) * vr_real.col(j + 1).cast<std::complex<double>>();
+        out.vectors.col(j + 1) = out.vectors.col(j).conjugate();
+        ++j;
+      } else {
+        out.vectors.col(j) = vr_real.col(j).cast<std::complex<double>>();
+      }
+    }
+  }
   return out;
 }
 
