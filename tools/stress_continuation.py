@@ -10,6 +10,7 @@ table, one line per failure and a summary.
 
   python3 tools/stress_continuation.py                       # 200 models, seed 1, 2 jobs
   python3 tools/stress_continuation.py --count 50 --seed 7 --csv /tmp/stress.csv
+  python3 tools/stress_continuation.py --set response.stability=false   # the continuation alone
 
 The corpus depends only on --seed (model i is drawn from its own generator seeded with
 "seed:i", so the first k models are the same whatever --count is). Pure Python (no numpy):
@@ -435,11 +436,13 @@ FRF_FIELDS = ["status", "message", "points", "pieces", "turning_points", "peak_a
               "peak_frequency_hz", "max_energy_balance_error"]
 
 
-def run_case(p, binary, out, timeout):
+def run_case(p, binary, out, timeout, sets=()):
     case = os.path.join(out, "cases", p["name"] + ".toml")
     rdir = os.path.join(out, "runs", p["name"])
     shutil.rmtree(rdir, ignore_errors=True)
     cmd = [binary, "frf", case, "--quiet", "--out", rdir, "--threads", "1"]
+    for s in sets:
+        cmd += ["--set", s]
     row = {"exit": None, "exit_class": None, "seconds": None, "stderr": ""}
     t0 = time.monotonic()
     try:
@@ -508,7 +511,12 @@ def main():
                          "so that a rebuild during the benchmark does not mix two programs)")
     ap.add_argument("--keep-results", action="store_true",
                     help="keep the result folders of runs that exit 0 too")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a case key for every run (repeatable), e.g. response.stability=false to time the "
+                         "continuation alone; continuation keys are refused (the corpus runs their defaults)")
     args = ap.parse_args()
+    if any(s.startswith("continuation.") for s in args.set):
+        ap.error("--set: the corpus runs the default continuation settings")
     if args.count < 1 or args.jobs < 1 or args.timeout <= 0:
         ap.error("--count and --jobs must be >= 1, --timeout > 0")
 
@@ -549,7 +557,7 @@ def main():
     done = [0]
 
     def work(i):
-        row = run_case(models[i], binary, out, args.timeout)
+        row = run_case(models[i], binary, out, args.timeout, args.set)
         with lock:
             done[0] += 1
             print("[%3d/%d] %s %-9s %7.2f s %s" % (done[0], len(models), models[i]["name"], row["exit_class"],
