@@ -249,8 +249,8 @@ int run_cli(int argc, char** argv) {
   }
   world.broadcast(std::filesystem::absolute(folder->staging()).string());
   if (world.distributed())
-    log::info("study: " + std::to_string(world.size()) + " MPI ranks, " + std::to_string(threads) +
-              " workers each unless --threads says otherwise per rank");
+    log::info("study: " + std::to_string(world.size()) + " MPI ranks; " + std::to_string(threads) +
+              (threads == 1 ? " worker" : " workers") + " on rank 0 (--threads sets the workers of each rank)");
   ctx.out_dir = folder->staging();
   ctx.threads = threads;
   ctx.overrides = o.sets;

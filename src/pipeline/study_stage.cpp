@@ -169,9 +169,12 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
   if (reused_points) *reused_points = reused;
   const distributed::World& world = distributed::world();
   const int threads = linalg::worker_count(ctx.threads, std::max<int>(1, static_cast<int>(to_run.size())));
-  log::info("study: " + std::to_string(to_run.size()) + " points on " + std::to_string(threads) + " workers" +
-            (world.distributed() ? " here and the workers of " + std::to_string(world.size() - 1) + " more ranks"
-                                 : std::string()));
+  const int others = world.size() - 1;
+  log::info("study: " + std::to_string(to_run.size()) + " points on " + std::to_string(threads) +
+            (threads == 1 ? " worker" : " workers") +
+            (others > 0
+                 ? " here and the workers of " + std::to_string(others) + (others == 1 ? " other rank" : " other ranks")
+                 : std::string()));
   std::vector<distributed::Json> tasks;
   for (const int i : to_run) tasks.push_back(point_task(ctx, points[static_cast<std::size_t>(i)], forced));
   const bool verbose = log::verbose();
