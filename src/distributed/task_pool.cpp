@@ -11,7 +11,6 @@
 #include "distributed/task_pool.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -229,7 +228,7 @@ Session::Session(int* argc, char*** argv) {
   MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
   MPI_Comm_size(node, &g_world.local_size_);
   MPI_Comm_free(&node);
-  g_world.transport_ = "MPI";
+  g_world.mpi_initialized_ = true;
 #else
   (void)argc, (void)argv;
 #endif
@@ -237,7 +236,7 @@ Session::Session(int* argc, char*** argv) {
 
 Session::~Session() {
 #ifdef SHROUDSIM_HAVE_MPI
-  if (!g_world.transport_.empty()) {
+  if (g_world.mpi_initialized_) {
     int finalized = 0;
     MPI_Finalized(&finalized);
     if (!finalized) MPI_Finalize();

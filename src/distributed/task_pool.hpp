@@ -40,8 +40,6 @@ class World {
   int size() const { return size_; }
   /// More than one rank: the tasks of rank 0 are shared with the others.
   bool distributed() const { return size_ > 1; }
-  /// "MPI" or "" (no MPI in this build, or no launcher).
-  const std::string& transport() const { return transport_; }
   /// Threads a rank runs when the user did not say (--threads 0): the hardware threads of the
   /// node shared among the ranks on it, at least one.
   int default_threads() const;
@@ -56,7 +54,7 @@ class World {
  private:
   friend class Session;
   int rank_ = 0, size_ = 1, local_size_ = 1;
-  std::string transport_;
+  bool mpi_initialized_ = false;  ///< this process called MPI_Init (Session finalizes it)
   bool released_ = false;
 };
 

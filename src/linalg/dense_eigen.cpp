@@ -20,6 +20,19 @@ void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a, const
 }
 
 namespace shroudsim::linalg {
+namespace {
+
+/// LAPACK's info of an xGEEV call: > 0, the QR algorithm missed that many eigenvalues.
+void check_info(int info, const char* routine, int n) {
+  if (info > 0)
+    throw NumericalError(std::string("the dense eigenproblem (LAPACK ") + routine + ", size " + std::to_string(n) +
+                         ") did not converge: " + std::to_string(info) + " eigenvalues missing");
+  if (info < 0)
+    throw std::invalid_argument(std::string("dense_eigen: ") + routine + " argument " + std::to_string(-info) +
+                                " is invalid");
+}
+
+}  // namespace
 
 DenseEigen dense_eigen(const Eigen::MatrixXcd& a, bool with_vectors) {
   if (a.rows() != a.cols()) throw std::invalid_argument("dense_eigen: the matrix is not square");
@@ -42,10 +55,7 @@ DenseEigen dense_eigen(const Eigen::MatrixXcd& a, bool with_vectors) {
   Eigen::VectorXcd work(lwork);
   zgeev_(&jobvl, &jobvr, &n, work_a.data(), &n, out.values.data(), &dummy, &one, vr, &ldvr, work.data(), &lwork,
          rwork.data(), &info, 1, 1);
-  if (info > 0)
-    throw NumericalError("the dense eigenproblem (LAPACK zgeev, size " + std::to_string(n) +
-                         ") did not converge: " + std::to_string(info) + " eigenvalues missing");
-  if (info < 0) throw std::invalid_argument("dense_eigen: zgeev argument " + std::to_string(-info) + " is invalid");
+  check_info(info, "zgeev", n);
   return out;
 }
 
@@ -70,10 +80,7 @@ DenseEigen dense_eigen(const Eigen::MatrixXd& a, bool with_vectors) {
   Eigen::VectorXd work(lwork);
   dgeev_(&jobvl, &jobvr, &n, work_a.data(), &n, wr.data(), wi.data(), &dummy, &one, vr, &ldvr, work.data(), &lwork,
          &info, 1, 1);
-  if (info > 0)
-    throw NumericalError("the dense eigenproblem (LAPACK dgeev, size " + std::to_string(n) +
-                         ") did not converge: " + std::to_string(info) + " eigenvalues missing");
-  if (info < 0) throw std::invalid_argument("dense_eigen: dgeev argument " + std::to_string(-info) + " is invalid");
+  check_info(info, "dgeev", n);
   for (int j = 0; j < n; ++j) out.values[j] = {wr[j], wi[j]};
   if (with_vectors) {
     // dgeev stores a conjugate pair (wi[j] > 0, then its conjugate) as two real columns,

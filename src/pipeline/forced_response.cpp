@@ -16,7 +16,6 @@
 #include "forced/stability.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "io/output.hpp"
-#include "linalg/blas.hpp"
 #include "pipeline/forced_model.hpp"
 #include "pipeline/forced_shapes.hpp"
 #include "study/curves.hpp"
@@ -72,10 +71,6 @@ void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyRes
 std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
                                                      forced::ReducedEquations& equations) {
   const log::Stopwatch clock;
-  // Hill problems are a few hundred wide: OpenBLAS's threads inside LAPACK cost more than they
-  // save there (stress model 7, Hill size 190: 76 s threaded against 21 s serial on a busy
-  // 2-core machine).
-  const linalg::SerialBlasScope serial;
   std::vector<forced::FloquetResult> out(response.points.size());
   std::vector<double> freq, amp;
   int unstable = 0, failed = 0, size = 0;
