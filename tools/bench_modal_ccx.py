@@ -1,20 +1,21 @@
 #!/usr/bin/python3
 """Modal pipeline against CalculiX, side by side on the generator's meshes.
 
-usage: tools/bench_modal_ccx.py [--case CASE] [--sizes S ...] [--modes M] [--threads T]
+usage: tools/bench_modal_ccx.py [--case CASE] [--sizes S ...] [--modes M] [--threads T ...]
                                 [--binary shroudsim] [--ccx ccx] [--work DIR]
 
 For each mesh size: the sector is meshed once by `shroudsim mesh` (gmsh, 10-node tets), then
-timed, each with T solver threads:
-  - `shroudsim modes CASE` (assembly, cyclic reduction, M modes of every harmonic index,
-    modes.csv, modes.vtu, the plot), from the mesh just made, with an empty modal cache (the
-    case is copied into the work folder, whose `.cache` starts empty);
+timed with each thread count T (default 1 and 2; T threads in every layer: shroudsim's
+workers, OpenBLAS, CalculiX's solver):
+  - `shroudsim modes CASE --threads T` (assembly, cyclic reduction, M modes of every harmonic
+    index, modes.csv, modes.vtu, the plot), from the mesh just made, with an empty modal cache
+    (the case is copied into the work folder, whose `.cache` is emptied before each run);
   - `ccx` (CalculiX) on the same mesh: C3D10 elements, the hub clamped, the cyclic faces tied
     by *TIE, CYCLIC SYMMETRY and *CYCLIC SYMMETRY MODEL (N = Nb, axis z), *FREQUENCY 2 M (CalculiX
     counts each cyclic mode twice, as its two real forms),
     *SELECT CYCLIC SYMMETRY MODES NMIN = 0, NMAX = Nb / 2.
-Prints a table: DOFs, the two wall times, their ratio, and the largest relative difference of
-the frequencies per nodal diameter (an independent check of the cyclic modal model: CalculiX
+Prints a table: DOFs, the wall times, the ratio at each thread count and of the best times,
+and the largest relative difference of the frequencies per nodal diameter (an independent check of the cyclic modal model: CalculiX
 has its own element and its own cyclic constraint). Needs /usr/bin/python3 with meshio and
 `ccx` (Debian package calculix-ccx); one run each: quote ratios from one run.
 """
@@ -130,7 +131,7 @@ def main(argv):
     ap.add_argument("--case", default=os.path.join(ROOT, "cases", "shrouded_blade.toml"))
     ap.add_argument("--sizes", type=float, nargs="+", default=[0.018, 0.0117, 0.0075])
     ap.add_argument("--modes", type=int, default=10)
-    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--binary", default=os.path.join(ROOT, "build", "src", "app", "shroudsim"))
     ap.add_argument("--ccx", default="ccx")
     ap.add_argument("--work", default="/tmp/bench_modal_ccx")
@@ -145,59 +146,85 @@ def main(argv):
                 "nu": read_case_value(case, "material", "poisson_ratio"),
                 "rho": read_case_value(case, "material", "density")}
     name = os.path.splitext(os.path.basename(case))[0]
-    env = dict(os.environ, OMP_NUM_THREADS=str(a.threads), CCX_NPROC_EQUATION_SOLVER=str(a.threads),
-               CCX_NPROC_STIFFNESS=str(a.threads))
     rows = []
     for size in a.sizes:
         work = os.path.join(a.work, f"h{size:g}")
         shutil.rmtree(work, ignore_errors=True)
         os.makedirs(work)
         # The case is copied into the work folder: the modal cache lives beside the case file
-        # (`.cache`), and a cached stage would time a lookup instead of the modal solve.
+        # (`.cache`, emptied before each timed run), and a cached stage would time a lookup
+        # instead of the modal solve.
         local_case = os.path.join(work, os.path.basename(case))
         shutil.copy(case, local_case)
         sets = ["--set", f"geometry.mesh_size={size}", "--set", f"modal.modes={a.modes}",
                 "--set", 'modal.harmonic_indices="all"']
-        common = ["--quiet", "--threads", str(a.threads)]
-        subprocess.run([binary, "mesh", local_case, "--out", os.path.join(work, "mesh")] + sets + common, cwd=work,
+        subprocess.run([binary, "mesh", local_case, "--out", os.path.join(work, "mesh"), "--quiet"] + sets, cwd=work,
                        check=True)
-        t0 = time.perf_counter()
-        subprocess.run([binary, "modes", local_case, "--out", os.path.join(work, "modes")] + sets + common, cwd=work,
-                       check=True)
-        t_ours = time.perf_counter() - t0
-        with open(os.path.join(work, "modes", "run.json")) as f:
-            import json
-            if any(st["name"] == "modes" and st["reused"] for st in json.load(f)["stages"]):
-                print(f"bench_modal_ccx: the modal stage was reused from a cache at {size}", file=sys.stderr)
-                return 1
         msh = os.path.join(work, "meshes", f"{name}.msh")
         if not os.path.exists(msh):
             found = [f for f in os.listdir(os.path.join(work, "meshes")) if f.endswith(".msh")]
             msh = os.path.join(work, "meshes", found[0])
         dofs = write_ccx_input(msh, os.path.join(work, "sector.inp"), sectors, a.modes, material)
-        t0 = time.perf_counter()
-        r = subprocess.run([a.ccx, "-i", "sector"], cwd=work, env=env, stdout=subprocess.DEVNULL,
-                           stderr=subprocess.PIPE, text=True)
-        t_ccx = time.perf_counter() - t0
-        if r.returncode != 0:
-            print(f"bench_modal_ccx: ccx failed at mesh size {size}: {r.stderr[-500:]}", file=sys.stderr)
-            return 1
-        ours = shroudsim_frequencies(os.path.join(work, "modes", "modes.csv"))
-        theirs = ccx_frequencies(os.path.join(work, "sector.dat"))
+        ours, theirs, stages = {}, {}, {}
+        for t in a.threads:
+            # T threads in every layer: shroudsim's workers and the BLAS (OpenBLAS otherwise
+            # starts one thread per core whatever --threads says), CalculiX's solver threads.
+            env = dict(os.environ, OMP_NUM_THREADS=str(t), OPENBLAS_NUM_THREADS=str(t),
+                       CCX_NPROC_EQUATION_SOLVER=str(t), CCX_NPROC_STIFFNESS=str(t))
+            shutil.rmtree(os.path.join(work, ".cache"), ignore_errors=True)
+            out = os.path.join(work, f"modes{t}")
+            t0 = time.perf_counter()
+            subprocess.run([binary, "modes", local_case, "--out", out, "--quiet", "--threads", str(t)] + sets,
+                           cwd=work, env=env, check=True)
+            ours[t] = time.perf_counter() - t0
+            with open(os.path.join(out, "run.json")) as f:
+                import json
+                run = json.load(f)
+            if any(st["name"] == "modes" and st["reused"] for st in run["stages"]):
+                print(f"bench_modal_ccx: the modal stage was reused from a cache at {size}", file=sys.stderr)
+                return 1
+            stages[t] = {st["name"]: st["seconds"] for st in run["stages"]}
+            t0 = time.perf_counter()
+            r = subprocess.run([a.ccx, "-i", "sector"], cwd=work, env=env, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE, text=True)
+            theirs[t] = time.perf_counter() - t0
+            if r.returncode != 0:
+                print(f"bench_modal_ccx: ccx failed at mesh size {size}: {r.stderr[-500:]}", file=sys.stderr)
+                return 1
+        f_ours = shroudsim_frequencies(os.path.join(work, f"modes{a.threads[0]}", "modes.csv"))
+        f_theirs = ccx_frequencies(os.path.join(work, "sector.dat"))
         worst = 0.0
-        for nd, fs in ours.items():
-            other = sorted(theirs.get(nd, []))[:len(fs)]
+        for nd, fs in f_ours.items():
+            other = sorted(f_theirs.get(nd, []))[:len(fs)]
             for f1, f2 in zip(sorted(fs), other):
                 worst = max(worst, abs(f1 - f2) / f2)
-        compared = sum(min(len(fs), len(theirs.get(nd, []))) for nd, fs in ours.items())
-        rows.append((size, dofs, t_ours, t_ccx, worst, compared))
-        print(f"mesh_size {size:g}: {dofs} DOFs, shroudsim {t_ours:.1f} s, ccx {t_ccx:.1f} s, "
-              f"max rel. freq. diff. {worst:.2e} over {compared} modes", file=sys.stderr, flush=True)
-    print(f"modes per nodal diameter: {a.modes}, Nb = {sectors}, threads: {a.threads}, case {os.path.basename(case)}")
-    print("| mesh_size | DOFs | shroudsim `modes` (s) | ccx (s) | ccx / shroudsim | max rel. freq. diff. (modes compared) |")
+        compared = sum(min(len(fs), len(f_theirs.get(nd, []))) for nd, fs in f_ours.items())
+        rows.append((size, dofs, ours, theirs, stages, worst, compared))
+        print(f"mesh_size {size:g}: {dofs} DOFs, shroudsim " +
+              ", ".join(f"{ours[t]:.1f} s ({t} thr.)" for t in a.threads) + "; ccx " +
+              ", ".join(f"{theirs[t]:.1f} s ({t} thr.)" for t in a.threads) +
+              f"; max rel. freq. diff. {worst:.2e} over {compared} modes", file=sys.stderr, flush=True)
+    print(f"modes per nodal diameter: {a.modes}, Nb = {sectors}, case {os.path.basename(case)}")
+    head = "| mesh_size | DOFs | " + " | ".join(f"shroudsim {t} thr. (s)" for t in a.threads) + " | " + \
+        " | ".join(f"ccx {t} thr. (s)" for t in a.threads) + " | " + \
+        " | ".join(f"ratio at {t} thr." for t in a.threads) + " | best / best | max rel. freq. diff. (modes) |"
+    print(head)
+    print("|" + " --- |" * (head.count("|") - 1))
+    for size, dofs, ours, theirs, stages, worst, n in rows:
+        best = min(theirs.values()) / min(ours.values())
+        print(f"| {size:g} | {dofs:,} | " + " | ".join(f"{ours[t]:.1f}" for t in a.threads) + " | " +
+              " | ".join(f"{theirs[t]:.1f}" for t in a.threads) + " | " +
+              " | ".join(f"{theirs[t] / ours[t]:.1f}x" for t in a.threads) + f" | {best:.1f}x | {worst:.2e} ({n}) |")
+    print()
+    print("Where shroudsim's time goes (run.json stages, s; the rest: start-up, output files, the plot):")
+    print("| mesh_size | threads | mesh (read) | assembly | modes | rest |")
     print("| --- | --- | --- | --- | --- | --- |")
-    for size, dofs, t1, t2, worst, n in rows:
-        print(f"| {size:g} | {dofs:,} | {t1:.1f} | {t2:.1f} | {t2 / t1:.1f}x | {worst:.2e} ({n}) |")
+    for size, dofs, ours, theirs, stages, worst, n in rows:
+        for t in a.threads:
+            st = stages[t]
+            known = sum(st.get(k, 0.0) for k in ("mesh", "assembly", "modes"))
+            print(f"| {size:g} | {t} | {st.get('mesh', 0.0):.2f} | {st.get('assembly', 0.0):.2f} | "
+                  f"{st.get('modes', 0.0):.2f} | {ours[t] - known:.2f} |")
     return 0
 
 

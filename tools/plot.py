@@ -40,6 +40,9 @@ PLOTS = [
 ]
 
 
+NO_MATPLOTLIB = 3
+
+
 def main(argv):
     args = argv[1:]
     shroud = None
@@ -55,7 +58,10 @@ def main(argv):
     if not os.path.isdir(result_dir):
         print(f"plot.py: {result_dir}: no such result folder", file=sys.stderr)
         return 2
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        return NO_MATPLOTLIB
     matplotlib.use("Agg")
     status = 0
     for filename, module, function in PLOTS:

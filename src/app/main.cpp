@@ -3,9 +3,11 @@
 #include <iostream>
 
 #include "app/cli.hpp"
+#include "core/allocator.hpp"
 #include "distributed/task_pool.hpp"
 
 int main(int argc, char** argv) {
+  shroudsim::core::configure_allocator();  // before any thread exists
   // MPI_Init under an MPI launcher (`mpirun -n K shroudsim study`), MPI_Finalize at the end.
   shroudsim::distributed::Session mpi(&argc, &argv);
   try {

@@ -24,6 +24,17 @@ namespace {
 template <typename Scalar>
 struct Decomposition : Eigen::CholmodDecomposition<SparseMatrix<Scalar>, Eigen::Lower> {
   cholmod_factor* factor() const { return this->m_cholmodFactor; }
+  // analyzePattern() without the analysis: a copy of another's symbolic factor (CHOLMOD's
+  // pattern-only cholmod_factor carries no scalar type), in this object's workspace.
+  void adopt_symbolic(const cholmod_factor* symbolic) {
+    if (this->m_cholmodFactor) cholmod_free_factor(&this->m_cholmodFactor, &this->cholmod());
+    this->m_cholmodFactor = cholmod_copy_factor(const_cast<cholmod_factor*>(symbolic), &this->cholmod());
+    const bool ok = this->m_cholmodFactor != nullptr;
+    this->m_isInitialized = ok;
+    this->m_info = ok ? Eigen::Success : Eigen::InvalidInput;
+    this->m_analysisIsOk = ok;
+    this->m_factorizationIsOk = false;
+  }
 };
 }  // namespace
 
@@ -101,6 +112,24 @@ FactorStatus CholmodFactor<Scalar>::compute(const SparseMatrix<Scalar>& A) {
 }
 
 template <typename Scalar>
+bool CholmodFactor<Scalar>::symbolic_only() const {
+  const cholmod_factor* f = impl_->llt.factor();
+  return f && f->xtype == CHOLMOD_PATTERN;
+}
+
+template <typename Scalar>
+template <typename Other>
+void CholmodFactor<Scalar>::analyze_like(const CholmodFactor<Other>& analysed) {
+  SHROUDSIM_CHECK(analysed.symbolic_only(), "CholmodFactor::analyze_like: the source must be analysed, not factorized");
+  impl_->llt.adopt_symbolic(analysed.impl_->llt.factor());
+  // The analysis statistics (factor_nonzeros() reads them) come with the analysis.
+  impl_->llt.cholmod().lnz = analysed.impl_->llt.cholmod().lnz;
+  impl_->llt.cholmod().fl = analysed.impl_->llt.cholmod().fl;
+  rows_ = analysed.rows_;
+  status_ = impl_->llt.info() == Eigen::Success ? FactorStatus::Success : FactorStatus::Failed;
+}
+
+template <typename Scalar>
 typename CholmodFactor<Scalar>::Matrix CholmodFactor<Scalar>::solve(const Matrix& b) const {
   SHROUDSIM_CHECK(status_ == FactorStatus::Success, "CholmodFactor::solve without a valid factor");
   SHROUDSIM_CHECK(b.rows() == rows_, "CholmodFactor::solve: right-hand side has the wrong size");
@@ -156,5 +185,9 @@ double CholmodFactor<Scalar>::factor_nonzeros() const {
 
 template class CholmodFactor<double>;
 template class CholmodFactor<Complex>;
+template void CholmodFactor<double>::analyze_like(const CholmodFactor<double>&);
+template void CholmodFactor<double>::analyze_like(const CholmodFactor<Complex>&);
+template void CholmodFactor<Complex>::analyze_like(const CholmodFactor<double>&);
+template void CholmodFactor<Complex>::analyze_like(const CholmodFactor<Complex>&);
 
 }  // namespace shroudsim::linalg

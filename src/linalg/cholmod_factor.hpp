@@ -48,6 +48,15 @@ class CholmodFactor {
   FactorStatus factorize(const SparseMatrix<Scalar>& A);
   /// analyze() then factorize().
   FactorStatus compute(const SparseMatrix<Scalar>& A);
+  /// The symbolic analysis copied from `analysed` instead of computed: a factor of either
+  /// scalar type on which analyze() has been called and factorize() has not. The analysis
+  /// depends on the pattern only, so every matrix of one pattern (every harmonic index of a
+  /// cyclic sector, real or complex) can share one; `analysed` is only read (several threads
+  /// may copy it at once). Its matrix must have A's pattern; then factorize(A).
+  template <typename Other>
+  void analyze_like(const CholmodFactor<Other>& analysed);
+  /// True once analyze() has run and factorize() has not: a source for analyze_like().
+  bool symbolic_only() const;
 
   /// x = A^{-1} b for one or several right-hand sides (columns). Requires status() == Success.
   Matrix solve(const Matrix& b) const;
@@ -69,6 +78,8 @@ class CholmodFactor {
   double factor_nonzeros() const;
 
  private:
+  template <typename>
+  friend class CholmodFactor;
   struct Impl;
   /// x = the half solve (CHOLMOD systems `first` then `second`) of ncol columns of b, after
   /// checking the factor; `name` is the calling function's, for the messages.

@@ -12,10 +12,9 @@
 namespace shroudsim::modal {
 namespace {
 
-constexpr std::uint64_t kMagicMatrices = 0x32584d4b4d495353ull;  // "SSIMKMX2": key and checksum
-constexpr std::uint64_t kMagicBasis = 0x32534142444f4d53ull;     // "SMODBAS2": key and checksum
+constexpr std::uint64_t kMagicBasis = 0x32534142444f4d53ull;  // "SMODBAS2": key and checksum
 
-// Largest cache file read (a 240k-DOF sector's K and M are about 0.5 GB).
+// Largest cache file read (50 modes of a 240k-DOF sector are about 0.2 GB).
 constexpr std::uintmax_t kMaxCacheBytes = 8ull << 30;
 
 // FNV-1a, 64 bit, over the whole entry before the checksum.
@@ -113,49 +112,7 @@ std::optional<std::istringstream> read_entry(const std::filesystem::path& path, 
   return in;
 }
 
-void put_sparse(std::ostream& out, const linalg::SparseMatrixD& A) {
-  SHROUDSIM_CHECK(A.isCompressed(), "cache: sparse matrix must be compressed");
-  put<std::int64_t>(out, A.rows());
-  put<std::int64_t>(out, A.cols());
-  put_array(out, A.outerIndexPtr(), A.cols() + 1);
-  put_array(out, A.innerIndexPtr(), A.nonZeros());
-  put_array(out, A.valuePtr(), A.nonZeros());
-}
-
-bool get_sparse(std::istream& in, linalg::SparseMatrixD& A) {
-  std::int64_t rows = 0, cols = 0;
-  if (!get(in, rows) || !get(in, cols) || rows < 0 || cols < 0 || rows > (1ll << 31) || cols > (1ll << 31))
-    return false;
-  std::vector<int> outer(cols + 1);
-  if (!get_array(in, outer.data(), cols + 1)) return false;
-  const std::int64_t nnz = outer.back();
-  if (nnz < 0 || outer.front() != 0) return false;
-  A.resize(rows, cols);
-  A.resizeNonZeros(nnz);
-  std::copy(outer.begin(), outer.end(), A.outerIndexPtr());
-  return get_array(in, A.innerIndexPtr(), nnz) && get_array(in, A.valuePtr(), nnz);
-}
-
 }  // namespace
-
-void save_matrices(const std::filesystem::path& path, const std::string& key, const linalg::SparsePair<double>& km) {
-  write_atomic(path, kMagicMatrices, key, [&](std::ostream& out) {
-    put_sparse(out, km.K);
-    put_sparse(out, km.M);
-  });
-}
-
-std::optional<linalg::SparsePair<double>> load_matrices(const std::filesystem::path& path, const std::string& key,
-                                                        std::string* problem) {
-  auto in = read_entry(path, kMagicMatrices, key, problem);
-  if (!in) return std::nullopt;
-  linalg::SparsePair<double> km;
-  if (!get_sparse(*in, km.K) || !get_sparse(*in, km.M)) {
-    if (problem) *problem = "malformed payload";
-    return std::nullopt;
-  }
-  return km;
-}
 
 void save_basis(const std::filesystem::path& path, const std::string& key, const ModalBasis& basis) {
   write_atomic(path, kMagicBasis, key, [&](std::ostream& out) {

@@ -1,5 +1,6 @@
 #pragma once
-// On-disk cache of FE matrices and modal bases (binary, this machine's byte order).
+// On-disk cache of modal bases (binary, this machine's byte order). K and M are not cached:
+// assembling them is faster than reading them back (modal/modal_stage.hpp).
 // A file holds a magic tag (kind and format version), the key it was written under, the
 // payload and a 64-bit checksum (FNV-1a) of all of that. A file that does not match (other
 // kind or version, another key, truncated, any changed byte, non-finite modes) is never
@@ -17,10 +18,6 @@
 namespace shroudsim::modal {
 
 /// problem (optional): set when the file exists but cannot be used (left empty when absent).
-void save_matrices(const std::filesystem::path& path, const std::string& key, const linalg::SparsePair<double>& km);
-std::optional<linalg::SparsePair<double>> load_matrices(const std::filesystem::path& path, const std::string& key,
-                                                        std::string* problem = nullptr);
-
 void save_basis(const std::filesystem::path& path, const std::string& key, const ModalBasis& basis);
 std::optional<ModalBasis> load_basis(const std::filesystem::path& path, const std::string& key,
                                      std::string* problem = nullptr);

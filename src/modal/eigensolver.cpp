@@ -152,7 +152,8 @@ template <typename S>
 std::shared_ptr<linalg::CholmodFactor<S>> factor_checked(const linalg::SparsePair<S>& km, const ModalOptions& options,
                                                          FactorReuse* reuse, ModalReport& report) {
   log::Stopwatch watch;
-  std::shared_ptr<linalg::CholmodFactor<S>> factor = factor_shifted<S>(km, options.shift, options.factor_method, reuse);
+  std::shared_ptr<linalg::CholmodFactor<S>> factor =
+      factor_shifted<S>(km, options.shift, options.factor_method, reuse, options.analysis.get());
   report.factor_seconds = watch.seconds();
   report.factor_nonzeros = factor->factor_nonzeros();
   if (factor->status() != linalg::FactorStatus::Success) {

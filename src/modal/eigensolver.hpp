@@ -60,6 +60,10 @@ struct ModalOptions {
   double tolerance = 1e-10;          ///< Spectra's relative tolerance on the Ritz values
   double residual_tolerance = 1e-6;  ///< accepted ||K phi - w^2 M phi|| / ||K phi||
   linalg::FactorMethod factor_method = linalg::FactorMethod::Supernodal;
+  /// The symbolic analysis of K - shift M's pattern, shared by the solves of every harmonic
+  /// index (modal/shift_invert.hpp); null, or a pattern of another size: each solve analyses.
+  /// Not part of the result: the factors are the same either way.
+  std::shared_ptr<const SharedAnalysis> analysis;
   /// Returns false and appends messages if a value is out of range.
   bool validate(std::vector<std::string>* errors) const;
 };

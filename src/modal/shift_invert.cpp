@@ -20,19 +20,64 @@ Eigen::Index& reuse_nonzeros(FactorReuse& reuse) {
   else return reuse.real_nonzeros;
 }
 
+// K - sigma M, compressed (K itself, uncopied, when sigma == 0 and K is compressed).
+template <typename S>
+struct Shifted {
+  linalg::SparseMatrix<S> owned;
+  const linalg::SparseMatrix<S>* matrix = nullptr;
+  Shifted(const linalg::SparsePair<S>& km, double sigma) {
+    if (sigma == 0.0 && km.K.isCompressed()) {
+      matrix = &km.K;
+      return;
+    }
+    owned = sigma == 0.0 ? linalg::SparseMatrix<S>(km.K) : linalg::SparseMatrix<S>(km.K - S(sigma) * km.M);
+    owned.makeCompressed();
+    matrix = &owned;
+  }
+};
+
 }  // namespace
 
 template <typename S>
+std::shared_ptr<const SharedAnalysis> analyse_pattern(const linalg::SparsePair<S>& km, double sigma,
+                                                      linalg::FactorMethod method) {
+  const Shifted<S> shifted(km, sigma);
+  const linalg::SparseMatrix<S>& A = *shifted.matrix;
+  auto factor = std::make_shared<linalg::CholmodFactor<double>>(method);
+  if constexpr (kIsComplex<S>) {
+    linalg::SparseMatrix<double> pattern(A.real());  // every stored entry kept: the same pattern
+    pattern.makeCompressed();
+    factor->analyze(pattern);
+  } else {
+    factor->analyze(A);
+  }
+  auto out = std::make_shared<SharedAnalysis>();
+  out->rows = A.rows();
+  out->nonzeros = A.nonZeros();
+  if (factor->status() == linalg::FactorStatus::Success) out->symbolic = std::move(factor);
+  return out;
+}
+
+template std::shared_ptr<const SharedAnalysis> analyse_pattern<double>(const linalg::SparsePair<double>&, double,
+                                                                       linalg::FactorMethod);
+template std::shared_ptr<const SharedAnalysis> analyse_pattern<Complex>(const linalg::SparsePair<Complex>&, double,
+                                                                        linalg::FactorMethod);
+
+template <typename S>
 std::shared_ptr<linalg::CholmodFactor<S>> factor_shifted(const linalg::SparsePair<S>& km, double sigma,
-                                                         linalg::FactorMethod method, FactorReuse* reuse) {
+                                                         linalg::FactorMethod method, FactorReuse* reuse,
+                                                         const SharedAnalysis* shared) {
   std::shared_ptr<linalg::CholmodFactor<S>> factor;
-  linalg::SparseMatrix<S> A = sigma == 0.0 ? linalg::SparseMatrix<S>(km.K)
-                                           : linalg::SparseMatrix<S>(km.K - S(sigma) * km.M);
-  A.makeCompressed();
+  const Shifted<S> shifted(km, sigma);
+  const linalg::SparseMatrix<S>& A = *shifted.matrix;
   if (reuse && reuse_slot<S>(*reuse) && reuse_slot<S>(*reuse)->rows() == A.rows() &&
       reuse_nonzeros<S>(*reuse) == A.nonZeros()) {
     factor = reuse_slot<S>(*reuse);
     factor->factorize(A);  // symbolic analysis of an earlier solve, same pattern
+  } else if (!reuse && shared && shared->symbolic && shared->rows == A.rows() && shared->nonzeros == A.nonZeros()) {
+    factor = std::make_shared<linalg::CholmodFactor<S>>(method);
+    factor->analyze_like(*shared->symbolic);
+    if (factor->status() == linalg::FactorStatus::Success) factor->factorize(A);
   } else {
     factor = std::make_shared<linalg::CholmodFactor<S>>(method);
     factor->compute(A);
@@ -48,10 +93,10 @@ std::shared_ptr<linalg::CholmodFactor<S>> factor_shifted(const linalg::SparsePai
 
 template std::shared_ptr<linalg::CholmodFactor<double>> factor_shifted<double>(const linalg::SparsePair<double>&,
                                                                                double, linalg::FactorMethod,
-                                                                               FactorReuse*);
+                                                                               FactorReuse*, const SharedAnalysis*);
 template std::shared_ptr<linalg::CholmodFactor<Complex>> factor_shifted<Complex>(const linalg::SparsePair<Complex>&,
                                                                                  double, linalg::FactorMethod,
-                                                                                 FactorReuse*);
+                                                                                 FactorReuse*, const SharedAnalysis*);
 
 template <typename S>
 ShiftInvertOperator<S>::ShiftInvertOperator(const linalg::CholmodFactor<S>& factor, const linalg::SparseMatrix<S>& M)

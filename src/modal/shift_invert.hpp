@@ -38,11 +38,29 @@ struct FactorReuse {
   int factorizations = 0;                                  ///< numeric factorizations done through this object
 };
 
+/// One symbolic analysis (fill-reducing ordering, supernodes) shared by the factorizations of
+/// K_h - sigma M_h of every harmonic index: the reduced matrices of a cyclic sector all have
+/// one pattern (cyclic/cyclic_sector.hpp), real or complex, and the analysis depends on the
+/// pattern only, so the factors are the ones a fresh analysis gives. Made once before the
+/// workers start; only read afterwards (several threads copy it at once).
+struct SharedAnalysis {
+  std::shared_ptr<const linalg::CholmodFactor<double>> symbolic;  ///< analysed, never factorized
+  Eigen::Index rows = 0, nonzeros = 0;                            ///< of the analysed pattern
+};
+
+/// The analysis of the pattern of K - sigma M (K when sigma == 0), by `method`.
+template <typename Scalar>
+std::shared_ptr<const SharedAnalysis> analyse_pattern(const linalg::SparsePair<Scalar>& km, double sigma,
+                                                      linalg::FactorMethod method);
+
 /// Factorizes K - sigma M (K itself when sigma == 0), reusing reuse's symbolic analysis when
-/// the pattern matches (reuse may be null). Never null; check status() before use.
+/// the pattern matches (reuse may be null), else `shared`'s when its pattern has the same
+/// size and number of entries (may be null), else analysing afresh. Never null; check
+/// status() before use.
 template <typename Scalar>
 std::shared_ptr<linalg::CholmodFactor<Scalar>> factor_shifted(const linalg::SparsePair<Scalar>& km, double sigma,
-                                                              linalg::FactorMethod method, FactorReuse* reuse);
+                                                              linalg::FactorMethod method, FactorReuse* reuse,
+                                                              const SharedAnalysis* shared = nullptr);
 
 /// C applied to vectors or blocks, for Scalar S = double or Complex. `factor` is the
 /// successful factor of K - sigma M and `M` the mass matrix of the same problem; both must

@@ -110,20 +110,19 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
 
   // K and M.
   const modal::StageCache cache{cache_dir, [&ctx](const std::string& m) { ctx.report.warn(m); }};
-  modal::CachedMatrices matrices = modal::cached_matrices(model.mesh, model.material, cache, ctx.threads);
+  modal::SectorMatrices matrices = modal::assemble_matrices(model.mesh, model.material, ctx.threads);
   model.km = std::move(matrices.km);
   const std::string& km_key = matrices.key;
-  const bool km_reused = matrices.reused;
   const double km_seconds = matrices.seconds;
   log::Stopwatch clock;
-  ctx.report.stage("assembly", km_seconds, km_reused);
+  ctx.report.stage("assembly", km_seconds, false);  // assembled every time (modal/modal_stage.hpp)
   report["matrices"] = {{"key", km_key},
-                        {"reused", km_reused},
+                        {"reused", false},
                         {"seconds", km_seconds},
                         {"dofs", model.mesh.n_dofs()},
                         {"stored_entries_K", model.km.K.nonZeros()}};
-  log::info(std::string(km_reused ? "reused" : "assembled") + " K and M: " + std::to_string(model.mesh.n_dofs()) +
-            " DOFs, " + std::to_string(model.km.K.nonZeros()) + " stored entries (" + fixed(km_seconds, 2) + " s)");
+  log::info("assembled K and M: " + std::to_string(model.mesh.n_dofs()) + " DOFs, " +
+            std::to_string(model.km.K.nonZeros()) + " stored entries (" + fixed(km_seconds, 2) + " s)");
 
   if (shroud == Shroud::contact) {
     // The pairs the interference closes at rest (campbell follows the state with speed).

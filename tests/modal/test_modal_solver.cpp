@@ -196,6 +196,41 @@ TEST(SolveHarmonic, KeptStiffnessFactorSolvesKh) {
   }
 }
 
+TEST(SolveHarmonic, OneSharedAnalysisGivesTheModesOfAFreshAnalysisBitForBit) {
+  // Every K_h of the sector has one pattern; one symbolic analysis (made from a complex
+  // index) serves the real and the complex solves. CHOLMOD's analysis reads the pattern
+  // only, so the factors, and with them the modes, must be identical to the last bit.
+  const auto& sector = bladed_sector();
+  ModalOptions fresh, shared;
+  fresh.modes = shared.modes = 6;
+  shared.analysis = analyse_pattern(sector.reduce(2), 0.0, shared.factor_method);
+  ASSERT_TRUE(shared.analysis && shared.analysis->symbolic);
+  EXPECT_EQ(shared.analysis->rows, sector.n_reduced());
+  for (int h : {0, 1, 2, 4}) {
+    const ModalResult a = solve_harmonic(sector, h, fresh), b = solve_harmonic(sector, h, shared);
+    ASSERT_TRUE(a.report.ok() && b.report.ok()) << h;
+    EXPECT_EQ(a.basis.omega, b.basis.omega) << h;
+    EXPECT_EQ(a.basis.phi, b.basis.phi) << h;
+    EXPECT_EQ(a.report.factor_nonzeros, b.report.factor_nonzeros) << h;
+    // The kept stiffness factor solves K_h as well.
+    ASSERT_TRUE(b.stiffness.valid());
+    const Eigen::MatrixXcd f = Eigen::MatrixXcd::Ones(sector.n_reduced(), 1);
+    const auto km = sector.reduce(h);
+    EXPECT_LT((km.K * b.stiffness.solve(f) - f).norm(), 1e-9 * f.norm()) << h;
+  }
+}
+
+TEST(CholmodFactor, AnalyzeLikeRefusesAFactorizedSource) {
+  // A numeric factor is not a symbolic analysis: copying it would carry its values and its
+  // scalar type into another factorization.
+  const auto km = grid_laplacian<double>(6, 0.0);
+  linalg::CholmodFactor<double> numeric;
+  ASSERT_EQ(numeric.compute(km.K), linalg::FactorStatus::Success);
+  EXPECT_FALSE(numeric.symbolic_only());
+  linalg::CholmodFactor<Complex> target;
+  EXPECT_THROW(target.analyze_like(numeric), std::exception);
+}
+
 TEST(SolveHarmonic, UnconvergedLanczosIsReportedNotReturned) {
   const auto& sector = bladed_sector();
   ModalOptions options;
@@ -233,17 +268,10 @@ TEST(SolveHarmonic, ShiftAboveTheFirstModeIsAFactorizationFailure) {
   EXPECT_EQ(r.basis.size(), 0);
 }
 
-TEST(ModalCache, RoundTripsMatricesAndBases) {
+TEST(ModalCache, RoundTripsBases) {
   const auto dir = std::filesystem::temp_directory_path() / "shroudsim_modal_cache_test";
   std::filesystem::remove_all(dir);
-  const mesh::Mesh m = fe::box_mesh(1, 1, 1, 2, 2, 2, 2);
-  const auto km = fe::assemble(m, kSteel, 1);
-  save_matrices(dir / "km.bin", "key-km", km);
   std::string problem;
-  const auto back = load_matrices(dir / "km.bin", "key-km", &problem);
-  ASSERT_TRUE(back.has_value()) << problem;
-  EXPECT_EQ((back->K - km.K).norm(), 0.0);
-  EXPECT_EQ((back->M - km.M).norm(), 0.0);
   ModalBasis b{3, Eigen::VectorXd::LinSpaced(4, 1.0, 4.0), Eigen::MatrixXcd::Random(7, 4)};
   save_basis(dir / "b.bin", "key-b", b);
   const auto bb = load_basis(dir / "b.bin", "key-b");
@@ -257,9 +285,6 @@ TEST(ModalCache, RoundTripsMatricesAndBases) {
   EXPECT_TRUE(problem.empty());
   EXPECT_FALSE(load_basis(dir / "b.bin", "key-other", &problem).has_value());
   EXPECT_FALSE(problem.empty());
-  problem.clear();
-  EXPECT_FALSE(load_matrices(dir / "b.bin", "key-b", &problem).has_value());
-  EXPECT_FALSE(problem.empty());
   std::filesystem::remove_all(dir);
 }
 
@@ -268,14 +293,11 @@ TEST(ModalCache, RoundTripsMatricesAndBases) {
 TEST(ModalCache, CorruptedBytesAreDetectedAtEveryOffset) {
   const auto dir = std::filesystem::temp_directory_path() / "shroudsim_modal_cache_corrupt";
   std::filesystem::remove_all(dir);
-  const mesh::Mesh m = fe::box_mesh(1, 1, 1, 2, 2, 2, 1);
-  const auto km = fe::assemble(m, kSteel, 1);
   ModalBasis b{1, Eigen::VectorXd::LinSpaced(5, 1.0, 5.0), Eigen::MatrixXcd::Random(9, 5)};
-  save_matrices(dir / "km.bin", "k", km);
   save_basis(dir / "b.bin", "k", b);
   int checked = 0;
-  for (const char* name : {"km.bin", "b.bin"}) {
-    const auto file = dir / name;
+  {
+    const auto file = dir / "b.bin";
     std::string bytes;
     {
       std::ifstream in(file, std::ios::binary);
@@ -288,10 +310,8 @@ TEST(ModalCache, CorruptedBytesAreDetectedAtEveryOffset) {
       bad[at] = static_cast<char>(bad[at] ^ 0x5a);
       std::ofstream(file, std::ios::binary | std::ios::trunc) << bad;
       std::string problem;
-      const bool used = std::string(name) == "km.bin" ? load_matrices(file, "k", &problem).has_value()
-                                                      : load_basis(file, "k", &problem).has_value();
-      EXPECT_FALSE(used) << name << " byte " << at;
-      EXPECT_FALSE(problem.empty()) << name << " byte " << at;
+      EXPECT_FALSE(load_basis(file, "k", &problem).has_value()) << "byte " << at;
+      EXPECT_FALSE(problem.empty()) << "byte " << at;
       ++checked;
     }
     std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes.substr(0, n / 2);
@@ -299,7 +319,7 @@ TEST(ModalCache, CorruptedBytesAreDetectedAtEveryOffset) {
     EXPECT_FALSE(load_basis(file, "k", &problem).has_value());
     EXPECT_FALSE(problem.empty());
   }
-  EXPECT_EQ(checked, 128);
+  EXPECT_EQ(checked, 64);
   std::filesystem::remove_all(dir);
 }
 
