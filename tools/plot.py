@@ -2,6 +2,7 @@
 """Plots of a shroudsim result folder (matplotlib).
 
 usage: tools/plot.py RESULT_DIR [--shroud open|stuck|contact]
+       tools/plot.py --wait      (the same arguments, one per line, on stdin: see below)
 
 --shroud names the shroud state of the modal model in the titles of nd_map.png and
 campbell.png (modal.shroud of the case).
@@ -13,11 +14,14 @@ Draws whatever the folder holds results for:
   contact.json         -> contact_loops.png (hysteresis loops of one contact pair)
   frf.csv              -> frf.png           (nonlinear and linear forced response)
   loops.csv            -> loops.png         (contact loops at the peak)
+  nlmodes.csv          -> nlmodes.png       (nonlinear mode: frequency and damping against amplitude,
+                                             and the forced responses synthesized from it)
   contact_map.csv      -> contact.png       (energy, stick/slip/open of each pair at each shape)
   frf.vtu              -> shape.png         (the largest peak's deflection shape; needs meshio)
   study.csv            -> study.png         (peak amplitude and frequency over a sweep)
   trade.csv            -> trade.png         (error against cost per knob, study --convergence)
-Exits 0 when it drew everything it found, 1 on a plotting failure, 2 on bad usage.
+Exits 0 when it drew everything it found, 1 on a plotting failure, 2 on bad usage, 3 (silently)
+when matplotlib is not installed: shroudsim then reports the plots as skipped.
 """
 import importlib
 import os
@@ -33,6 +37,7 @@ PLOTS = [
     ("static_contact.csv", "plotting.modal_plots", "plot_static_contact"),
     ("contact.json", "plotting.contact_plots", "plot_contact"),
     ("frf.csv", "plotting.frf_plots", "plot_frf"),
+    ("nlmodes.csv", "plotting.nlmodes_plots", "plot_nlmodes"),
     ("contact_map.csv", "plotting.contact_plots", "plot_contact_map"),
     ("frf.vtu", "plotting.shape_plots", "plot_shape"),
     ("study.csv", "plotting.study_plots", "plot_study"),
@@ -43,8 +48,27 @@ PLOTS = [
 NO_MATPLOTLIB = 3
 
 
+def wait_for_arguments():
+    """`plot.py --wait`: shroudsim starts the plotter with its command, so that Python and
+    matplotlib load while it computes, and writes the arguments (one per line) to its stdin
+    when the results are there. Empty stdin: the command drew no plots; nothing to do."""
+    try:
+        import matplotlib  # noqa: F401 (loaded now: the point of waiting)
+        matplotlib.use("Agg")
+        import matplotlib.pyplot  # noqa: F401
+    except ImportError:
+        sys.stdin.read()
+        return None, NO_MATPLOTLIB
+    args = [line.rstrip("\n") for line in sys.stdin]
+    return args, 0
+
+
 def main(argv):
     args = argv[1:]
+    if args == ["--wait"]:
+        args, status = wait_for_arguments()
+        if args is None or not args:
+            return status
     shroud = None
     if len(args) == 3 and args[1] == "--shroud" and args[2] in ("open", "stuck", "contact"):
         shroud = args[2]

@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string_view>
 
@@ -136,6 +137,10 @@ int run_cli(int argc, char** argv) {
       {"modes", "FE assembly, cyclic reduction, modes per harmonic index -> modes.csv", cmd_modes},
       {"campbell", "frequencies against speed with engine-order lines -> campbell.csv, crossings.csv", cmd_campbell},
       {"frf", "nonlinear forced response with continuation -> frf.csv", cmd_frf},
+      {"nlmodes",
+       "nonlinear mode (frequency and damping against amplitude, EPMC) of a lumped case and the forced responses "
+       "synthesized from it -> nlmodes.csv, nlmodes_synthesis.csv",
+       cmd_nlmodes},
       {"contact", "one contact pair under the prescribed motion of [motion] -> contact.json", cmd_contact},
       {"static",
        "shroud contact of the spinning sector (interference, friction) -> static_contact.csv, contact_static.vtu",
@@ -260,6 +265,9 @@ int run_cli(int argc, char** argv) {
     log::info("study --resume: " + (folder->resumed_from().empty() ? std::string("nothing to resume from")
                                                                    : "from " + folder->resumed_from()));
 
+  // Python and matplotlib load while the command computes (every command but `mesh` plots).
+  std::optional<EarlyPlotter> plotter;
+  if (command != "mesh") plotter.emplace();
   std::string state = "failed", message;
   try {
     status = subs[chosen].run(ctx);

@@ -2,6 +2,7 @@
 // indices -> modes.csv (the nodal diameter map), modes.vtu, nd_map.png; and the plots of
 // every command (draw_plots).
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -62,12 +63,93 @@ int run_program(const std::vector<std::string>& args, bool quiet) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+const std::string kPython = "/usr/bin/python3";
+
+/// The plotting process an EarlyPlotter started: `plot.py --wait`, its stdin a pipe.
+struct WaitingPlotter {
+  pid_t pid = -1;
+  int pipe = -1;  ///< write end
+  /// Ends it without plots: its stdin closed (it then exits at once, or after its imports).
+  void cancel() {
+    if (pid <= 0) return;
+    ::close(pipe);
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid = -1;
+  }
+  /// Sends the arguments (one per line), closes its stdin and waits: its exit status, -1
+  /// when it could not be told.
+  int run(const std::vector<std::string>& args) {
+    std::string text;
+    for (const auto& a : args) text += a + "\n";
+    // A plotter that died early must not take this process with it (SIGPIPE).
+    struct sigaction ignore {
+    }, before{};
+    ignore.sa_handler = SIG_IGN;
+    ::sigaction(SIGPIPE, &ignore, &before);
+    bool sent = true;
+    for (std::size_t done = 0; done < text.size();) {
+      const ssize_t n = ::write(pipe, text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        sent = false;
+        break;
+      }
+      done += static_cast<std::size_t>(n);
+    }
+    ::close(pipe);
+    ::sigaction(SIGPIPE, &before, nullptr);
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0)
+      if (errno != EINTR) {
+        status = -1;
+        break;
+      }
+    pid = -1;
+    if (!sent) return -1;
+    return status >= 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+};
+
+WaitingPlotter g_plotter;  // one command per process: at most one
+
 }  // namespace
+
+EarlyPlotter::EarlyPlotter() {
+  const fs::path script = plot_script();
+  if (!fs::exists(kPython) || !fs::exists(script) || g_plotter.pid > 0) return;
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) return;  // later children (gmsh, ...) must not hold it open
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
+  posix_spawn_file_actions_addclose(&actions, fds[0]);
+  posix_spawn_file_actions_addclose(&actions, fds[1]);
+  const std::string script_path = script.string();
+  std::vector<std::string> args{kPython, script_path, "--wait"};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(fds[0]);
+  if (spawned != 0) {
+    ::close(fds[1]);
+    return;
+  }
+  g_plotter.pid = pid;
+  g_plotter.pipe = fds[1];
+}
+
+EarlyPlotter::~EarlyPlotter() { g_plotter.cancel(); }
 
 void draw_plots(Context& ctx) {
   if (!ctx.plots) return;  // study points: the study plots once at the end
   const fs::path script = plot_script();
-  const std::string python = "/usr/bin/python3";
+  const std::string& python = kPython;
   auto skipped = [&]() {
     log::info("plots skipped (needs /usr/bin/python3 with matplotlib and " + script.string() + ")");
     ctx.report.section("plots")["drawn"] = false;
@@ -86,9 +168,11 @@ void draw_plots(Context& ctx) {
       args.push_back(j[section]["shroud"].get<std::string>());
       break;
     }
-  // One interpreter start (0.3 s): the script itself says when matplotlib is missing.
+  // One interpreter start: the script itself says when matplotlib is missing. Started early
+  // (EarlyPlotter), it has imported matplotlib by now and is given the arguments only.
   constexpr int kNoMatplotlib = 3;  // tools/plot.py NO_MATPLOTLIB
-  const int rc = run_program(args, false);
+  const int rc = g_plotter.pid > 0 ? g_plotter.run(std::vector<std::string>(args.begin() + 2, args.end()))
+                                   : run_program(args, false);
   if (rc == kNoMatplotlib) {
     skipped();
     return;

@@ -19,6 +19,7 @@ int cmd_mesh(Context& ctx);
 int cmd_modes(Context& ctx);
 int cmd_campbell(Context& ctx);
 int cmd_frf(Context& ctx);
+int cmd_nlmodes(Context& ctx);
 int cmd_contact(Context& ctx);
 int cmd_static(Context& ctx);
 int cmd_study(Context& ctx);
@@ -31,7 +32,20 @@ nlohmann::json run_report(const Context& ctx, const std::string& command, const 
                           const std::string& message);
 
 /// Runs tools/plot.py on the result folder when /usr/bin/python3 has matplotlib; otherwise
-/// says that plots are skipped. A plotting failure is a warning, not an error.
+/// says that plots are skipped. A plotting failure is a warning, not an error. Uses the
+/// process an EarlyPlotter started, when there is one.
 void draw_plots(Context& ctx);
+
+/// Starts `tools/plot.py --wait` now, so that Python and matplotlib load (0.5 s) while the
+/// command computes; draw_plots then only sends it the arguments. Destroyed before
+/// draw_plots ran (a failed command, a command without plots), it ends that process unused.
+/// One per process.
+class EarlyPlotter {
+ public:
+  EarlyPlotter();
+  ~EarlyPlotter();
+  EarlyPlotter(const EarlyPlotter&) = delete;
+  EarlyPlotter& operator=(const EarlyPlotter&) = delete;
+};
 
 }  // namespace shroudsim::app

@@ -392,15 +392,7 @@ Eigen::VectorXd ReducedEquations::linear_motion(double frequency_hz) const {
   return w_lin;
 }
 
-Eigen::VectorXcd ReducedEquations::static_contact_load() const {
-  Eigen::VectorXcd f = Eigen::VectorXcd::Zero(linear_.n_contact());
-  if (n_directions_ != 3) return f;
-  for (int p = 0; p < contacts_.n_pairs(); ++p) {
-    const auto& pp = contacts_.pairs()[static_cast<std::size_t>(p)];
-    if (pp.preload_in_equilibrium) f[3 * p + 2] = std::max(0.0, pp.normal_preload);
-  }
-  return f;
-}
+Eigen::VectorXcd ReducedEquations::static_contact_load() const { return contacts_.static_load(); }
 
 Eigen::VectorXd ReducedEquations::stuck_solution(double frequency_hz) const {
   // Stuck, closed contacts: F = Kc W + F_pre (F_pre: the preload in the static normal term).

@@ -30,6 +30,25 @@ struct SecondOrderForm {
   Eigen::MatrixXcd P, R;
 };
 
+/// The receptances of the autonomous system of the extended periodic motion concept
+/// (forced/nonlinear_modes.hpp, docs/physics.md section 10): the mass-proportional damping
+/// -zeta M added to the linear part, so that for harmonic n at W = n w
+///   R_n(w, zeta) = (K - W^2 M + i W (C - zeta M))^-1      (lumped, exact)
+/// or, in modal form, each mode's denominator w_j^2 - W^2 + i W (2 xi_j w_j - zeta) (the
+/// massless residual flexibility is unchanged). With X_n = R_n B_n^H:
+///   G_n = B_n X_n (c x c),  H_n = D X_n (d x c, the response DOFs),
+/// and for the amplitude normalisation (n = 1 only, when asked) the modal mass of the
+/// motion q_1 = -X_1 F_1 the contact forces cause: q_1^H M q_1 = F_1^H N F_1 with
+///   N = X_1^H M X_1 (c x c, Hermitian; the massless part contributes nothing), and the
+/// excitation's projection on that motion, q_1^H f_ext,1 = -F_1^H e with e = X_1^H f_ext,1.
+/// Derivatives with respect to w [rad/s] and zeta [1/s] are exact.
+struct DampedReceptance {
+  Eigen::MatrixXcd G, dG_dw, dG_dzeta;  ///< c x c [m/N], [m/N/(rad/s)], [m/N s]
+  Eigen::MatrixXcd H;                   ///< d x c [m/N]
+  Eigen::MatrixXcd N, dN_dw, dN_dzeta;  ///< c x c [kg m^2/N^2 ...], n = 1 with the norm only
+  Eigen::VectorXcd e;                   ///< c [m], n = 1 with the norm only
+};
+
 struct HarmonicReceptance {
   Eigen::MatrixXcd G;      ///< c x c
   Eigen::VectorXcd w_lin;  ///< c
@@ -63,6 +82,13 @@ class LinearPart {
   virtual bool second_order_form(int n, SecondOrderForm& out) const {
     (void)n;
     (void)out;
+    return false;
+  }
+  /// The receptances of harmonic n >= 0 of the EPMC's autonomous system (DampedReceptance)
+  /// at fundamental circular frequency w and mass-proportional damping -zeta M; with_norm
+  /// (n = 1): also N, its derivatives and e. false when the model has no such form.
+  virtual bool damped_harmonic(int n, double w, double zeta, bool with_norm, DampedReceptance& out) const {
+    (void)n, (void)w, (void)zeta, (void)with_norm, (void)out;
     return false;
   }
   /// Human-readable description (for run.json).

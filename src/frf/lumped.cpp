@@ -61,6 +61,34 @@ void LumpedLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const 
   out.u_lin = rf.segment(response_dof_, 1);
 }
 
+bool LumpedLinearPart::damped_harmonic(int n, double w, double zeta, bool with_norm, DampedReceptance& out) const {
+  using Complex = std::complex<double>;
+  const double big_w = n * w;
+  const Eigen::MatrixXcd mc = m_.cast<Complex>(), cz = (c_ - zeta * m_).cast<Complex>();
+  const Eigen::MatrixXcd dyn = k_.cast<Complex>() - big_w * big_w * mc + Complex(0.0, big_w) * cz;
+  // dD/dw = -2 n^2 w M + i n (C - zeta M),  dD/dzeta = -i n w M,  dX = -R dD X.
+  const Eigen::MatrixXcd d_dw = -2.0 * n * big_w * mc + Complex(0.0, n) * cz;
+  const Eigen::MatrixXcd d_dzeta = Complex(0.0, -big_w) * mc;
+  const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(dyn);
+  const Eigen::MatrixXcd bc = b_.cast<Complex>();
+  const Eigen::MatrixXcd x = lu.solve(bc.transpose());
+  const Eigen::MatrixXcd dx_dw = -lu.solve(d_dw * x), dx_dzeta = -lu.solve(d_dzeta * x);
+  out.G = bc * x;
+  out.dG_dw = bc * dx_dw;
+  out.dG_dzeta = bc * dx_dzeta;
+  out.H = x.row(response_dof_);
+  if (with_norm && n == 1) {
+    const Eigen::MatrixXcd mx = mc * x;
+    out.N = x.adjoint() * mx;
+    out.dN_dw = dx_dw.adjoint() * mx;
+    out.dN_dw += out.dN_dw.adjoint().eval();
+    out.dN_dzeta = dx_dzeta.adjoint() * mx;
+    out.dN_dzeta += out.dN_dzeta.adjoint().eval();
+    out.e = x.adjoint() * force_vector().cast<Complex>();
+  }
+  return lu.rcond() > 0 && out.G.allFinite();
+}
+
 bool LumpedLinearPart::second_order_form(int /*n*/, SecondOrderForm& out) const {
   out.M = m_;
   out.C = c_;

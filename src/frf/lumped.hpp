@@ -33,6 +33,8 @@ class LumpedLinearPart : public LinearPart {
   std::string describe() const override;
   /// M, C, K of the model, P = B (no massless part): the same for every harmonic.
   bool second_order_form(int n, SecondOrderForm& out) const override;
+  /// The exact (K - W^2 M + i W (C - zeta M))^-1 projected, with its exact derivatives.
+  bool damped_harmonic(int n, double w, double zeta, bool with_norm, DampedReceptance& out) const override;
   /// sqrt(eig(K, M)) / 2 pi.
   std::vector<double> resonances_hz() const override;
 

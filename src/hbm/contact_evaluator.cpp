@@ -91,6 +91,16 @@ ContactEvaluator::ContactEvaluator(const ContactEvaluatorOptions& options, std::
 
 ContactEvaluator::~ContactEvaluator() = default;
 
+Eigen::VectorXcd ContactEvaluator::static_load() const {
+  Eigen::VectorXcd f = Eigen::VectorXcd::Zero(3 * n_pairs());
+  if (layout_.n_directions() != 3) return f;
+  for (int p = 0; p < n_pairs(); ++p) {
+    const auto& pp = pairs_[static_cast<std::size_t>(p)];
+    if (pp.preload_in_equilibrium) f[3 * p + 2] = std::max(0.0, pp.normal_preload);
+  }
+  return f;
+}
+
 void ContactEvaluator::to_time(const double* w, Workspace& ws) {
   const int m = layout_.per_direction();
   ws.w.setZero();

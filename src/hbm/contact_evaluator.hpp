@@ -28,6 +28,7 @@
 #include "contact/periodic_law.hpp"
 #include "hbm/aft.hpp"
 #include "hbm/harmonic_layout.hpp"
+#include "hbm/nonlinear_force.hpp"
 
 namespace shroudsim::hbm {
 
@@ -56,11 +57,6 @@ struct ContactEvaluatorOptions {
   bool validate(std::vector<std::string>* errors) const;
 };
 
-struct EvaluationStatus {
-  int unconverged_pairs = 0;  ///< pairs whose damper state did not repeat within max_periods
-  int max_periods = 0;        ///< largest number of periods any pair used
-};
-
 /// Everything about one pair's evaluation (for `shroudsim contact` and the plots).
 struct PairDetail {
   Eigen::MatrixX3d w;        ///< N x 3 relative displacement samples [m] (x, y, z)
@@ -70,23 +66,27 @@ struct PairDetail {
   contact::PeriodicStatus status;
 };
 
-class ContactEvaluator {
+class ContactEvaluator : public NonlinearForce {
  public:
   /// Throws std::invalid_argument with the violated constraint on bad options or pairs.
   ContactEvaluator(const ContactEvaluatorOptions& options, std::vector<contact::PairParameters> pairs);
-  ~ContactEvaluator();
+  ~ContactEvaluator() override;
   ContactEvaluator(const ContactEvaluator&) = delete;
   ContactEvaluator& operator=(const ContactEvaluator&) = delete;
 
-  const HarmonicLayout& pair_layout() const { return layout_; }
-  int n_pairs() const { return static_cast<int>(pairs_.size()); }
+  const HarmonicLayout& pair_layout() const override { return layout_; }
+  int n_pairs() const override { return static_cast<int>(pairs_.size()); }
   int size() const { return n_pairs() * layout_.size(); }  ///< length of W and F
   const ContactEvaluatorOptions& options() const { return options_; }
   const std::vector<contact::PairParameters>& pairs() const { return pairs_; }
 
   /// f = F(w); when jacobian != nullptr also the per-pair blocks dF_p/dW_p (method of the
   /// options). Sizes are checked (std::logic_error). Non-finite w -> std::invalid_argument.
-  EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f, std::vector<Eigen::MatrixXd>* jacobian);
+  EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f,
+                            std::vector<Eigen::MatrixXd>* jacobian) override;
+  /// The normal max(0, N0) of every pair with PairParameters::preload_in_equilibrium (3D
+  /// models), else 0 (as forced::ReducedEquations).
+  Eigen::VectorXcd static_load() const override;
   /// The same with an explicit Jacobian method (comparisons and benchmarks).
   EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f, std::vector<Eigen::MatrixXd>* jacobian,
                             JacobianMethod method);

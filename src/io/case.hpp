@@ -140,6 +140,15 @@ struct ContinuationSection {
   int max_points;
 };
 
+/// [nlmodes]: the nonlinear mode of `shroudsim nlmodes` (forced/nonlinear_modes.hpp).
+struct NlmodesSection {
+  double amplitude_start;  ///< modal amplitude a [m kg^0.5] (q_1^H M q_1 = a^2)
+  double amplitude_end;
+  int mode;  ///< 1-based linear mode index
+  int max_points;
+  std::vector<double> synthesis_scales;  ///< excitation scales of the synthesized curves
+};
+
 /// One harmonic of a prescribed motion: x(t) += c cos(n w t) + s sin(n w t).
 struct MotionHarmonic {
   int harmonic = 0;
@@ -192,6 +201,7 @@ struct Case {
   ContactSection contact;
   HbmSection hbm;
   ContinuationSection continuation;
+  NlmodesSection nlmodes;
   MotionSection motion;
   StudySection study;
   /// Where each key came from: "file:line:col" or "file: --set key=value" (for messages

@@ -704,6 +704,31 @@ Schema declare() {
             "maximum number of solution points")
       .range(1, 1'000'000);
 
+  d.section("nlmodes",
+            "only for `shroudsim nlmodes` (lumped models): the nonlinear mode by the extended periodic motion concept");
+  auto& a_start = d.number("nlmodes.amplitude_start", at(&Case::nlmodes, &NlmodesSection::amplitude_start), 1e-6,
+                           "m kg^0.5",
+                           "smallest modal amplitude a (the fundamental's q_1^H M q_1 = a^2): where the contacts "
+                           "still stick (a contact open at rest carries no force there: start above its closing)")
+                      .above(0);
+  d.number("nlmodes.amplitude_end", at(&Case::nlmodes, &NlmodesSection::amplitude_end), 1e-2, "m kg^0.5",
+           "largest modal amplitude: into gross slip")
+      .above(0)
+      .compare(">", a_start);
+  d.integer("nlmodes.mode", at(&Case::nlmodes, &NlmodesSection::mode), 1, "",
+            "the linear mode (1-based, by ascending frequency, contacts linearized at rest) the nonlinear mode starts "
+            "from")
+      .range(1, 1'000'000);
+  d.integer("nlmodes.max_points", at(&Case::nlmodes, &NlmodesSection::max_points), 500, "",
+            "maximum number of points (the step is at most 0.05 decades of amplitude)")
+      .range(2, 1'000'000);
+  d.numbers("nlmodes.synthesis_scales", at(&Case::nlmodes, &NlmodesSection::synthesis_scales), {0.5, 1.0, 2.0}, "",
+            "excitation levels (multiples of the case's excitation) of the forced responses synthesized from the "
+            "mode (nlmodes_synthesis.csv)")
+      .rule("every scale > 0 and finite", [](const Case&, const std::vector<double>& v) {
+        return std::all_of(v.begin(), v.end(), [](double f) { return f > 0.0 && std::isfinite(f); });
+      });
+
   d.section("motion", "only for `shroudsim contact`: prescribed relative motion, rows [harmonic, cosine, sine] in m");
   motion(d, "motion.x", &MotionSection::x, {{1, 1e-5, 0.0}}, "relative tangential motion x(t)");
   motion(d, "motion.y", &MotionSection::y, {}, "relative tangential motion y(t)");

@@ -1,0 +1,124 @@
+#include "pipeline/nonlinear_modes_stage.hpp"
+
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "forced/mode_synthesis.hpp"
+#include "forced/nonlinear_modes.hpp"
+#include "hbm/contact_evaluator.hpp"
+#include "io/output.hpp"
+#include "pipeline/forced_model.hpp"
+
+namespace shroudsim::pipeline {
+namespace {
+
+/// nlmodes.csv: one row per amplitude.
+void write_nlmodes_csv(const std::filesystem::path& file, const forced::NonlinearModeCurve& curve, int harmonics) {
+  std::ostringstream csv;
+  csv << "amplitude,frequency_hz,damping_ratio,zeta,contact_damping_ratio,contact_dissipation_j,"
+         "response_per_amplitude,modal_force_re,modal_force_im,newton_iterations";
+  for (int n = 0; n <= harmonics; ++n) csv << ",h" << n;
+  csv << "\n";
+  for (const auto& p : curve.points) {
+    csv << io::format_number(p.amplitude) << "," << io::format_number(p.frequency_hz) << ","
+        << io::format_number(p.damping_ratio) << "," << io::format_number(p.zeta) << ","
+        << io::format_number(p.contact_damping_ratio) << "," << io::format_number(p.contact_dissipation) << ","
+        << io::format_number(p.response_per_amplitude) << "," << io::format_number(p.modal_force.real()) << ","
+        << io::format_number(p.modal_force.imag()) << "," << p.newton_iterations;
+    for (double h : p.harmonic_amplitudes) csv << "," << io::format_number(h);
+    csv << "\n";
+  }
+  io::write_file_atomic(file, csv.str());
+}
+
+}  // namespace
+
+NonlinearModesOutcome run_nonlinear_modes(Context& ctx) {
+  const io::Case& c = ctx.config;
+  const log::Stopwatch clock;
+  if (c.structure.type != io::StructureType::lumped)
+    throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
+                     "\": `nlmodes` needs a lumped model (structure.type = \"lumped\"); the FE sector is not "
+                     "supported yet");
+  if (c.hbm.harmonics_auto)
+    throw InputError(c.where("hbm.harmonics") +
+                     ": hbm.harmonics = \"auto\" violates: a number for `nlmodes` (the search is the forced "
+                     "response's)");
+  if (c.hbm.time_samples_auto)
+    throw InputError(c.where("hbm.time_samples") + ": hbm.time_samples = \"auto\" violates: a number for `nlmodes`");
+  ForcedModel model = make_lumped_model(c);
+  hbm::ContactEvaluator contacts(evaluator_options(c, ctx.threads), model.pairs);
+  forced::NonlinearModeSettings settings;
+  settings.amplitude_start = c.nlmodes.amplitude_start;
+  settings.amplitude_end = c.nlmodes.amplitude_end;
+  settings.mode = c.nlmodes.mode;
+  settings.max_points = c.nlmodes.max_points;
+  settings.tolerance = c.hbm.tolerance;
+  forced::NonlinearModeCurve curve;
+  try {
+    curve = forced::trace_nonlinear_mode(*model.linear, contacts, settings);
+  } catch (const InputError& e) {
+    // The key the message is about (it starts with it), else the mode's.
+    const std::string what = e.what();
+    const std::string key = what.rfind("nlmodes.amplitude_start", 0) == 0 ? "nlmodes.amplitude_start" : "nlmodes.mode";
+    throw InputError(c.where(key) + ": " + what);
+  }
+  const double trace_seconds = clock.seconds();
+  write_nlmodes_csv(ctx.out_dir / "nlmodes.csv", curve, c.hbm.harmonics);
+
+  // The synthesized forced responses.
+  auto& j = ctx.report.section("nlmodes");
+  j["mode"] = c.nlmodes.mode;
+  j["linear_frequency_hz"] = curve.linear.omega / (2.0 * 3.141592653589793);
+  j["linear_damping_ratio"] = curve.linear.zeta / (2.0 * curve.linear.omega);
+  j["points"] = curve.points.size();
+  j["reached_end"] = curve.reached_end;
+  j["message"] = curve.message;
+  j["rejected_steps"] = curve.rejected_steps;
+  j["residual_evaluations"] = curve.residual_evaluations;
+  j["trace_seconds"] = trace_seconds;
+  if (!curve.points.empty()) {
+    const auto& last = curve.points.back();
+    j["end_frequency_hz"] = last.frequency_hz;
+    double d_max = 0.0, a_max = 0.0;
+    for (const auto& p : curve.points)
+      if (p.damping_ratio > d_max) d_max = p.damping_ratio, a_max = p.amplitude;
+    j["max_damping_ratio"] = d_max;
+    j["max_damping_amplitude"] = a_max;
+  }
+  std::ostringstream syn;
+  syn << "scale,frequency_hz,amplitude_m,modal_amplitude,upper\n";
+  auto& peaks = j["synthesis"];
+  peaks = nlohmann::json::array();
+  for (double s : c.nlmodes.synthesis_scales) {
+    const log::Stopwatch sc;
+    const std::vector<forced::SynthesisPoint> pts = forced::synthesize(curve.points, s);
+    const forced::SynthesisPeak peak = forced::synthesis_peak(curve.points, s);
+    const double seconds = sc.seconds();
+    for (const auto& p : pts)
+      syn << io::format_number(s) << "," << io::format_number(p.frequency_hz) << "," << io::format_number(p.amplitude)
+          << "," << io::format_number(p.modal_amplitude) << "," << (p.above_backbone ? 1 : 0) << "\n";
+    nlohmann::json e = {{"scale", s}, {"points", pts.size()}, {"seconds", seconds}, {"peak_found", peak.found}};
+    if (peak.found) {
+      e["peak_frequency_hz"] = peak.frequency_hz;
+      e["peak_amplitude_m"] = peak.amplitude;
+    } else {
+      e["note"] = "the mode's amplitude range ends below this level's peak (raise nlmodes.amplitude_end)";
+    }
+    peaks.push_back(e);
+  }
+  io::write_file_atomic(ctx.out_dir / "nlmodes_synthesis.csv", syn.str());
+  ctx.report.stage("nlmodes", clock.seconds());
+  std::ostringstream msg;
+  msg << "nlmodes: " << curve.points.size() << " points, " << j["linear_frequency_hz"].get<double>() << " Hz -> "
+      << (curve.points.empty() ? 0.0 : curve.points.back().frequency_hz) << " Hz, largest damping ratio "
+      << j.value("max_damping_ratio", 0.0);
+  log::info(msg.str());
+  NonlinearModesOutcome out;
+  if (!curve.reached_end) out.failure = "nlmodes: the curve stopped before nlmodes.amplitude_end: " + curve.message;
+  return out;
+}
+
+}  // namespace shroudsim::pipeline
