@@ -131,29 +131,19 @@ int main(int argc, char** argv) {
   }
   // Where a factorization's time goes: the symbolic analysis (fill-reducing ordering,
   // supernodes) against the numeric factorization, for a real and a complex index.
+  auto time_factor = [](const auto& K, auto factor, double& analysis, double& numeric) {
+    log::Stopwatch t;
+    factor.analyze(K);
+    analysis = t.seconds();
+    t.restart();
+    factor.factorize(K);
+    numeric = t.seconds();
+  };
   for (int h : {0, 1}) {
     if (2 * h > nb) continue;
-    log::Stopwatch t;
     double analysis = 0.0, numeric = 0.0;
-    if (sector.is_real(h)) {
-      const auto kmh = sector.reduce_real(h);
-      linalg::CholmodFactor<double> f;
-      t.restart();
-      f.analyze(kmh.K);
-      analysis = t.seconds();
-      t.restart();
-      f.factorize(kmh.K);
-      numeric = t.seconds();
-    } else {
-      const auto kmh = sector.reduce(h);
-      linalg::CholmodFactor<linalg::Complex> f;
-      t.restart();
-      f.analyze(kmh.K);
-      analysis = t.seconds();
-      t.restart();
-      f.factorize(kmh.K);
-      numeric = t.seconds();
-    }
+    if (sector.is_real(h)) time_factor(sector.reduce_real(h).K, linalg::CholmodFactor<double>(), analysis, numeric);
+    else time_factor(sector.reduce(h).K, linalg::CholmodFactor<linalg::Complex>(), analysis, numeric);
     std::printf("  h = %d factor: analysis %.2f s + numeric %.2f s\n", h, analysis, numeric);
   }
   double parallel_s = 0.0;

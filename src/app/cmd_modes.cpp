@@ -41,26 +41,28 @@ fs::path plot_script() {
   return fs::path(SHROUDSIM_SOURCE_DIR) / "tools" / "plot.py";
 }
 
-/// Runs argv[0] with these arguments (no shell: paths with quotes or spaces pass unchanged),
-/// its output to /dev/null when `quiet`; the exit status, or -1 when it could not start.
-int run_program(const std::vector<std::string>& args, bool quiet) {
+/// Starts argv[0] with these arguments (no shell: paths with quotes or spaces pass
+/// unchanged) and the given file actions (may be null); its pid, or -1 when it could not start.
+pid_t spawn(const std::vector<std::string>& args, const posix_spawn_file_actions_t* actions) {
   std::vector<char*> argv;
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  if (quiet) {
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
-  }
   pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) return -1;
+  return posix_spawn(&pid, argv[0], actions, nullptr, argv.data(), environ) == 0 ? pid : -1;
+}
+
+/// Waits for the child `pid`: its exit status, or -1 (killed by a signal, or not waitable).
+int wait_exit_status(pid_t pid) {
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
+  while (::waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) return -1;
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/// Runs the program to its end: its exit status, or -1 when it could not start.
+int run_program(const std::vector<std::string>& args) {
+  const pid_t pid = spawn(args, nullptr);
+  return pid < 0 ? -1 : wait_exit_status(pid);
 }
 
 const std::string kPython = "/usr/bin/python3";
@@ -74,9 +76,7 @@ struct WaitingPlotter {
     if (pid <= 0) return;
     ::close(pipe);
     ::kill(pid, SIGTERM);
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+    wait_exit_status(pid);
     pid = -1;
   }
   /// Sends the arguments (one per line), closes its stdin and waits: its exit status, -1
@@ -101,15 +101,9 @@ struct WaitingPlotter {
     }
     ::close(pipe);
     ::sigaction(SIGPIPE, &before, nullptr);
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0)
-      if (errno != EINTR) {
-        status = -1;
-        break;
-      }
+    const int status = wait_exit_status(pid);
     pid = -1;
-    if (!sent) return -1;
-    return status >= 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return sent ? status : -1;
   }
 };
 
@@ -127,16 +121,10 @@ EarlyPlotter::EarlyPlotter() {
   posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
   posix_spawn_file_actions_addclose(&actions, fds[0]);
   posix_spawn_file_actions_addclose(&actions, fds[1]);
-  const std::string script_path = script.string();
-  std::vector<std::string> args{kPython, script_path, "--wait"};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  const pid_t pid = spawn({kPython, script.string(), "--wait"}, &actions);
   posix_spawn_file_actions_destroy(&actions);
   ::close(fds[0]);
-  if (spawned != 0) {
+  if (pid < 0) {
     ::close(fds[1]);
     return;
   }
@@ -172,7 +160,7 @@ void draw_plots(Context& ctx) {
   // (EarlyPlotter), it has imported matplotlib by now and is given the arguments only.
   constexpr int kNoMatplotlib = 3;  // tools/plot.py NO_MATPLOTLIB
   const int rc = g_plotter.pid > 0 ? g_plotter.run(std::vector<std::string>(args.begin() + 2, args.end()))
-                                   : run_program(args, false);
+                                   : run_program(args);
   if (rc == kNoMatplotlib) {
     skipped();
     return;

@@ -53,6 +53,16 @@ struct Jenkins {
     omega = std::sqrt((k + a1 / a) / m);
     damping = (c / m - b1 / (omega * m * a)) / (2 * omega);
   }
+  /// The largest relative differences of a traced curve's w and D from closed_form.
+  void worst_errors(const NonlinearModeCurve& curve, double& worst_w, double& worst_d) const {
+    worst_w = worst_d = 0.0;
+    for (const auto& p : curve.points) {
+      double omega = 0, damping = 0;
+      closed_form(p.amplitude, omega, damping);
+      worst_w = std::max(worst_w, std::abs(p.omega / omega - 1));
+      worst_d = std::max(worst_d, std::abs(p.damping_ratio / damping - 1));
+    }
+  }
 };
 
 std::unique_ptr<hbm::ContactEvaluator> jenkins_evaluator(const Jenkins& sys, contact::Model model, int h, int n) {
@@ -304,11 +314,8 @@ TEST(NonlinearModes, JenkinsAtOneHarmonicIsTheDescribingFunction) {
   // Newton tolerance.
   constexpr double kSolverTolerance = 1e-8;
   double worst_w = 0.0, worst_d = 0.0;
+  sys.worst_errors(curve, worst_w, worst_d);
   for (const auto& p : curve.points) {
-    double omega = 0, damping = 0;
-    sys.closed_form(p.amplitude, omega, damping);
-    worst_w = std::max(worst_w, std::abs(p.omega / omega - 1));
-    worst_d = std::max(worst_d, std::abs(p.damping_ratio / damping - 1));
     // Energy: the friction dissipation per cycle is the closed form 4 Fs (a - Fs/kt).
     EXPECT_NEAR(p.contact_dissipation, contact::jenkins_dissipation(sys.kt, sys.fs, p.amplitude),
                 1e-8 * sys.fs * p.amplitude);
@@ -377,12 +384,7 @@ TEST(NonlinearModes, JenkinsWithSevenHarmonicsStaysWithinTheHarmonicError) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_TRUE(curve.reached_end) << curve.message;
   double worst_w = 0.0, worst_d = 0.0;
-  for (const auto& p : curve.points) {
-    double omega = 0, damping = 0;
-    sys.closed_form(p.amplitude, omega, damping);
-    worst_w = std::max(worst_w, std::abs(p.omega / omega - 1));
-    worst_d = std::max(worst_d, std::abs(p.damping_ratio / damping - 1));
-  }
+  sys.worst_errors(curve, worst_w, worst_d);
   std::printf("Jenkins H=7 N=256: %zu points in %.3f s, worst |w/w_df - 1| = %.2e, |D/D_df - 1| = %.2e\n",
               curve.points.size(), seconds, worst_w, worst_d);
   // The higher harmonics of the friction force (odd, ~ 1/n^2 of the fundamental's slip part)

@@ -1,4 +1,5 @@
 """Plotters of shroudsim's result files (tools/plot.py dispatches to them)."""
+import csv
 import os
 import re
 
@@ -10,3 +11,9 @@ def result_name(result_dir):
     name = os.path.basename(os.path.normpath(result_dir))
     m = re.fullmatch(r"\.(.+)\.staging-\d+", name)
     return m.group(1) if m else name
+
+
+def read_csv(path):
+    """The rows of a result CSV file as dicts keyed by its header."""
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))

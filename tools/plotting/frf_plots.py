@@ -1,22 +1,16 @@
 #!/usr/bin/python3
 """frf.png: nonlinear forced response against the free linear response; loops.png:
 hysteresis loops of the contact pairs at the peak (from loops.csv)."""
-import csv
 import os
 
-from plotting import result_name
+from plotting import read_csv, result_name
 
-
-def _read_csv(path):
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    return rows
 
 
 def plot_frf(result_dir):
     import matplotlib.pyplot as plt
 
-    rows = _read_csv(os.path.join(result_dir, "frf.csv"))
+    rows = read_csv(os.path.join(result_dir, "frf.csv"))
     if not rows:
         return
     f = [float(r["frequency_hz"]) for r in rows]
@@ -68,13 +62,13 @@ def plot_frf(result_dir):
     pf, pa = max(zip(f, a), key=lambda p: p[1])
     peaks_csv = os.path.join(result_dir, "peaks.csv")
     if os.path.exists(peaks_csv):
-        for r in _read_csv(peaks_csv):
+        for r in read_csv(peaks_csv):
             if float(r["amplitude_m"]) >= pa:
                 pf, pa = float(r["frequency_hz"]), float(r["amplitude_m"])
     ax.plot([pf], [pa], "o", color="C3", label=f"peak {pa:.4g} m at {pf:.6g} Hz")
     # Every located peak (peaks.csv), labelled with its frequency and amplitude.
     if os.path.exists(peaks_csv):
-        for r in _read_csv(peaks_csv):
+        for r in read_csv(peaks_csv):
             if r.get("located", "1") not in ("1", "true"):
                 continue
             rf, ra = float(r["frequency_hz"]), float(r["amplitude_m"])
@@ -128,7 +122,7 @@ def plot_loops(result_dir):
     import matplotlib.pyplot as plt
     from matplotlib.ticker import ScalarFormatter
 
-    rows = _read_csv(os.path.join(result_dir, "loops.csv"))
+    rows = read_csv(os.path.join(result_dir, "loops.csv"))
     if not rows:
         return
     pairs = sorted({int(r["pair"]) for r in rows})

@@ -11,7 +11,6 @@ campbell.png: frequency against speed, one horizontal line per mode (colour = no
 diameter), engine-order lines f = EO * rpm / 60, and the crossings where an engine order
 meets a mode of the nodal diameter it excites.
 """
-import csv
 import json
 import math
 import os
@@ -21,10 +20,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def _read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+from plotting import read_csv  # noqa: E402
 
 
 def _families(rows):
@@ -48,7 +44,7 @@ def _shroud_note():
 
 
 def plot_nd_map(result_dir):
-    fam = _families(_read_csv(os.path.join(result_dir, "modes.csv")))
+    fam = _families(read_csv(os.path.join(result_dir, "modes.csv")))
     nds = sorted(fam)
     n_modes = max(len(v) for v in fam.values())
     fig, axes = plt.subplots(1, 2, figsize=(13, 6))
@@ -71,9 +67,9 @@ def plot_nd_map(result_dir):
 
 
 def plot_campbell(result_dir):
-    rows = _read_csv(os.path.join(result_dir, "campbell.csv"))
+    rows = read_csv(os.path.join(result_dir, "campbell.csv"))
     crossings_path = os.path.join(result_dir, "crossings.csv")
-    crossings = _read_csv(crossings_path) if os.path.exists(crossings_path) else []
+    crossings = read_csv(crossings_path) if os.path.exists(crossings_path) else []
     speeds = sorted({float(r["speed_rpm"]) for r in rows})
     s0, s1 = speeds[0], speeds[-1]
     lines = {}
@@ -147,7 +143,7 @@ if __name__ == "__main__":
 def plot_static_contact(result_dir):
     """contact_static.png: contact pressure and state of every shroud pair over the face
     (axial z against radius r of the shroud_high node), from static_contact.csv."""
-    rows = _read_csv(os.path.join(result_dir, "static_contact.csv"))
+    rows = read_csv(os.path.join(result_dir, "static_contact.csv"))
     if not rows:
         return
     z = [1e3 * float(r["z_m"]) for r in rows]

@@ -2,21 +2,16 @@
 """nlmodes.png: the nonlinear mode's frequency and damping ratio against the modal amplitude
 (log axis), from nlmodes.csv; with nlmodes_synthesis.csv, the forced responses synthesized
 from the mode at each excitation level (a third panel)."""
-import csv
 import os
 
-from plotting import result_name
+from plotting import read_csv, result_name
 
-
-def _read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def plot_nlmodes(result_dir):
     import matplotlib.pyplot as plt
 
-    rows = _read_csv(os.path.join(result_dir, "nlmodes.csv"))
+    rows = read_csv(os.path.join(result_dir, "nlmodes.csv"))
     if not rows:
         return
     a = [float(r["amplitude"]) for r in rows]
@@ -24,7 +19,7 @@ def plot_nlmodes(result_dir):
     d = [float(r["damping_ratio"]) for r in rows]
     dc = [float(r["contact_damping_ratio"]) for r in rows]
     syn_path = os.path.join(result_dir, "nlmodes_synthesis.csv")
-    syn = _read_csv(syn_path) if os.path.exists(syn_path) else []
+    syn = read_csv(syn_path) if os.path.exists(syn_path) else []
     panels = 3 if syn else 2
     fig, axes = plt.subplots(panels, 1, figsize=(8, 3.2 * panels))
     ax = axes[0]
