@@ -46,15 +46,17 @@ continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, d
                                                   const continuation::ArclengthOptions& options, Eigen::VectorXd& w) {
   ExcitationHomotopy homotopy(equations, frequency_hz);
   homotopy.lin_ = equations.linear_motion(frequency_hz);
+  // From no excitation to the equations' own excitation scale (1 unless a caller scaled it).
+  const double saved = equations.excitation_scale();
+  const double target = saved > 0.0 ? saved : 1.0;
   continuation::ArclengthOptions o = options;
   o.lambda_start = 0.0;
-  o.lambda_end = 1.0;
-  o.lambda_scale = 1.0;
+  o.lambda_end = target;
+  o.lambda_scale = target;
   o.initial_step = 0.05;
   o.max_step = 4.0;
   o.max_points = std::min(o.max_points, 2000);  // a start that needs more is not worth waiting for
-  o.start_slack = 1.0;                          // the path may fold back through s < 0 (the excitation reversed)
-  const double saved = equations.excitation_scale();
+  o.start_slack = target;                       // the path may fold back through s < 0 (the excitation reversed)
   equations.set_excitation_scale(0.0);
   const Eigen::VectorXd start = equations.stuck_solution(frequency_hz);
   continuation::Branch b = continuation::trace(homotopy, start, o);

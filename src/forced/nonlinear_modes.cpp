@@ -34,6 +34,22 @@ constexpr double kResidualFloor = 1e-6;
 /// the contacts carry no linear stiffness (there G has a pole): far above round-off, far
 /// below any amplitude-dependent shift that Newton then finds.
 constexpr double kPoleOffset = 1e-9;
+/// The static contact state: Newton on harmonic 0 to kStaticTolerance of the preload's
+/// static displacement (piecewise-linear contact laws converge in a few iterations).
+constexpr int kStaticIterations = 50;
+constexpr double kStaticTolerance = 1e-13;
+/// The probe of the contacts' linearization at the start, relative to the larger of the static
+/// state's largest displacement and the force's rest_displacement(): far below any slip or
+/// lift-off, far above round-off.
+constexpr double kProbe = 1e-7;
+/// The largest change of w, and of zeta (in units of w), per unit arclength step: the
+/// continuation's frequency unit (a step moves w by at most this fraction), far below the
+/// distance to another mode family.
+constexpr double kMaxJump = 0.02;
+/// The largest turn of the branch's direction per accepted step (scaled variables).
+constexpr double kMaxTurnDeg = 45.0;
+/// How far (decades) the branch may turn back below amplitude_start before it stops.
+constexpr double kBelowStart = 1.0;
 }  // namespace
 
 bool NonlinearModeSettings::validate(std::vector<std::string>* errors) const {
@@ -223,22 +239,76 @@ NonlinearModePoint NonlinearModeEquations::analyse(const Eigen::VectorXd& x, dou
   return p;
 }
 
-LinearMode linear_mode(const frf::LinearPart& linear, hbm::NonlinearForce& force, int mode) {
+Eigen::VectorXd static_contact_state(const frf::LinearPart& linear, hbm::NonlinearForce& force) {
+  const int n = force.n_unknowns(), c = linear.n_contact(), nd = force.pair_layout().n_directions();
+  const hbm::HarmonicLayout& layout = force.pair_layout();
+  const int b = layout.size();
+  frf::DampedReceptance r0;
+  if (!linear.damped_harmonic(0, 1.0, 0.0, false, r0))
+    throw NumericalError("nonlinear modes: the linear part has no static flexibility");
+  const Eigen::MatrixXd g0 = r0.G.real();
+  const Eigen::VectorXd f_static = force.static_load().real();
+  // z: harmonic 0 of W (c entries, 3 per pair, the unused directions zero).
+  auto to_w = [&](const Eigen::VectorXd& z) {
+    Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
+    for (int p = 0; p < force.n_pairs(); ++p)
+      for (int d = 0; d < nd; ++d) w[p * b + layout.index(d, 0, hbm::HarmonicLayout::Part::cosine)] = z[3 * p + d];
+    return w;
+  };
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(c), f;
+  std::vector<Eigen::MatrixXd> blocks;
+  double scale = 0.0;
+  for (int it = 0; it < kStaticIterations; ++it) {
+    force.evaluate(to_w(z), f, &blocks);
+    Eigen::VectorXd f0 = Eigen::VectorXd::Zero(c);
+    Eigen::MatrixXd df = Eigen::MatrixXd::Zero(c, c);
+    for (int p = 0; p < force.n_pairs(); ++p)
+      for (int d = 0; d < nd; ++d) {
+        const int i = layout.index(d, 0, hbm::HarmonicLayout::Part::cosine);
+        f0[3 * p + d] = f[p * b + i];
+        for (int e = 0; e < nd; ++e)
+          df(3 * p + d, 3 * p + e) =
+              blocks[static_cast<std::size_t>(p)](i, layout.index(e, 0, hbm::HarmonicLayout::Part::cosine));
+      }
+    const Eigen::VectorXd load = g0 * (f0 - f_static);
+    if (it == 0) scale = load.cwiseAbs().maxCoeff();
+    if (scale == 0.0) return to_w(z);  // the static state is W = 0
+    const Eigen::VectorXd r = z + load;
+    if (r.cwiseAbs().maxCoeff() <= kStaticTolerance * std::max(scale, z.cwiseAbs().maxCoeff())) return to_w(z);
+    const Eigen::MatrixXd j = Eigen::MatrixXd::Identity(c, c) + g0 * df;
+    z -= j.partialPivLu().solve(r);
+    if (!z.allFinite()) break;
+  }
+  throw NumericalError("nonlinear modes: the static contact state (harmonic 0 without vibration) did not converge");
+}
+
+LinearMode linear_mode(const frf::LinearPart& linear, hbm::NonlinearForce& force, int mode,
+                       const Eigen::VectorXd& state) {
+  using Complex = std::complex<double>;
   frf::SecondOrderForm so;
-  if (!linear.second_order_form(1, so) || so.R.cwiseAbs().maxCoeff() > 0.0)
-    throw InputError(
-        "nonlinear modes: the model has no second-order form without a massless part "
-        "(only lumped models are supported)");
+  if (!linear.second_order_form(1, so))
+    throw InputError("nonlinear modes: the model has no second-order form (docs/physics.md section 10)");
   const int m = static_cast<int>(so.M.rows());
   if (mode < 1 || mode > m)
     throw InputError("nlmodes.mode = " + std::to_string(mode) + " violates: <= " + std::to_string(m) +
-                     " (the model's DOFs)");
+                     " (the model's DOFs or modes)");
   // K_c: the force's first-harmonic stiffness at W = 0 (cosine row and column of harmonic 1
   // of every direction of each pair).
   const int c = linear.n_contact(), nd = force.pair_layout().n_directions();
   Eigen::VectorXd f;
   std::vector<Eigen::MatrixXd> blocks;
-  force.evaluate(Eigen::VectorXd::Zero(force.n_unknowns()), f, &blocks);
+  // The small vibration is taken through a probe of harmonic 1 in every direction, kProbe of
+  // the state's size (of the pairs' slip and lift-off displacements at rest): the Jacobian at
+  // a state without motion is that of a slipping contact (the sampled law's derivative where
+  // a sample does not move), and about a static load at the friction limit it is the slipping
+  // one where a small periodic motion, once the slider has settled, sticks.
+  Eigen::VectorXd probe = state.size() == 0 ? Eigen::VectorXd(Eigen::VectorXd::Zero(force.n_unknowns())) : state;
+  const double size = std::max(probe.cwiseAbs().maxCoeff(), force.rest_displacement());
+  for (int p = 0; p < force.n_pairs(); ++p)
+    for (int d = 0; d < force.pair_layout().n_directions(); ++d)
+      probe[p * force.pair_layout().size() + force.pair_layout().index(d, 1, hbm::HarmonicLayout::Part::cosine)] +=
+          kProbe * size;
+  force.evaluate(probe, f, &blocks);
   Eigen::MatrixXd kc = Eigen::MatrixXd::Zero(c, c);
   for (int p = 0; p < force.n_pairs(); ++p)
     for (int d = 0; d < nd; ++d)
@@ -246,17 +316,31 @@ LinearMode linear_mode(const frf::LinearPart& linear, hbm::NonlinearForce& force
         kc(3 * p + d, 3 * p + e) =
             blocks[static_cast<std::size_t>(p)](force.pair_layout().index(d, 1, hbm::HarmonicLayout::Part::cosine),
                                                 force.pair_layout().index(e, 1, hbm::HarmonicLayout::Part::cosine));
-  const Eigen::MatrixXd pr = so.P.real();
-  Eigen::MatrixXd k_lin = so.K + pr.transpose() * kc * pr;
-  k_lin = 0.5 * (k_lin + k_lin.transpose()).eval();
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(k_lin, so.M);
+  // The massless part condensed into the contact: W = P q - R F, F = K_c W give
+  // W = S P q with S = (I + R K_c)^-1 and F = K_c S P q.
+  const Eigen::MatrixXcd kcc = kc.cast<Complex>();
+  Eigen::MatrixXcd s = Eigen::MatrixXcd::Identity(c, c);
+  if (so.R.size() > 0 && so.R.cwiseAbs().maxCoeff() > 0.0)
+    s = (Eigen::MatrixXcd::Identity(c, c) + so.R * kcc).partialPivLu().inverse();
+  Eigen::MatrixXcd k_lin = so.K.cast<Complex>() + so.P.adjoint() * kcc * s * so.P;
+  k_lin = 0.5 * (k_lin + k_lin.adjoint()).eval();
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXcd> eig(k_lin, so.M.cast<Complex>());
   if (eig.info() != Eigen::Success || eig.eigenvalues()[mode - 1] <= 0)
     throw NumericalError("nonlinear modes: the linear mode " + std::to_string(mode) + " has no positive frequency");
   LinearMode lm;
   lm.omega = std::sqrt(eig.eigenvalues()[mode - 1]);
   lm.phi = eig.eigenvectors().col(mode - 1);
-  lm.phi /= std::sqrt(lm.phi.dot(so.M * lm.phi));
-  lm.zeta = lm.phi.dot(so.C * lm.phi);
+  lm.phi /= std::sqrt(lm.phi.dot(so.M.cast<Complex>() * lm.phi).real());
+  lm.contact_motion = s * so.P * lm.phi;
+  // The phase: the contact component that moves most is real and positive.
+  Eigen::Index j = 0;
+  lm.contact_motion.cwiseAbs().maxCoeff(&j);
+  if (std::abs(lm.contact_motion[j]) > 0) {
+    const Complex turn = std::abs(lm.contact_motion[j]) / lm.contact_motion[j];
+    lm.phi *= turn;
+    lm.contact_motion *= turn;
+  }
+  lm.zeta = lm.phi.dot(so.C.cast<Complex>() * lm.phi).real();
   lm.contact_stiffness = kc;
   return lm;
 }
@@ -266,13 +350,12 @@ NonlinearModeCurve trace_nonlinear_mode(const frf::LinearPart& linear, hbm::Nonl
   std::vector<std::string> errors;
   if (!settings.validate(&errors)) throw InputError(errors.front());
   NonlinearModeCurve curve;
-  curve.linear = linear_mode(linear, force, settings.mode);
+  const Eigen::VectorXd w_static = static_contact_state(linear, force);
+  curve.linear = linear_mode(linear, force, settings.mode, w_static);
   NonlinearModeEquations eq(linear, force);
   const int n = eq.n(), nd = force.pair_layout().n_directions();
   // Contact motion of the unit linear mode, the phase coefficient at its largest component.
-  frf::SecondOrderForm so;
-  linear.second_order_form(1, so);
-  const Eigen::VectorXd bphi = (so.P * curve.linear.phi.cast<std::complex<double>>()).real();
+  const Eigen::VectorXcd& bphi = curve.linear.contact_motion;
   double c_w = 0.0;
   int j_pair = 0, j_dir = 0;
   for (int p = 0; p < force.n_pairs(); ++p)
@@ -284,15 +367,15 @@ NonlinearModeCurve trace_nonlinear_mode(const frf::LinearPart& linear, hbm::Nonl
   eq.set_phase_index(eq.index(j_pair, j_dir, 1, true));
 
   const double w0 = curve.linear.omega;
-  // y = [W / a, w, zeta] as a function of lambda = log10 a: the predictor's variables.
+  // y = [(W - W_s) / a, w, zeta] as a function of lambda = log10 a (W_s the static state).
   auto to_x = [&](const Eigen::VectorXd& y, double a) {
     Eigen::VectorXd x = y;
-    x.head(n) *= a;
+    x.head(n) = w_static + a * y.head(n);
     return x;
   };
   auto to_y = [&](const Eigen::VectorXd& x, double a) {
     Eigen::VectorXd y = x;
-    y.head(n) /= a;
+    y.head(n) = (x.head(n) - w_static) / a;
     return y;
   };
   // Newton at amplitude a from x (in place), scaled by (a c_w, w0, w0).
@@ -331,10 +414,12 @@ NonlinearModeCurve trace_nonlinear_mode(const frf::LinearPart& linear, hbm::Nonl
   double lambda = std::log10(settings.amplitude_start);
   double a = settings.amplitude_start;
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n + 2);
-  for (int p = 0; p < force.n_pairs(); ++p)
-    for (int d = 0; d < nd; ++d) x[eq.index(p, d, 1, false)] = a * bphi[3 * p + d];
+  Eigen::VectorXd x_start = w_static;
+  eq.add_harmonic(a * bphi, 1, x_start);
+  x.head(n) = x_start;
   // The frequency guess: the Rayleigh quotient of the first-harmonic balance projected on
-  // phi, w^2 = phi^T K phi + phi^T B^H F_1(a B phi) / a, phi^T K phi = w0^2 - (B phi)^T K_c B phi.
+  // phi, w^2 = phi^H K phi + (P phi)^H F_1(a W_phi) / a, phi^H K phi = w0^2 - (P phi)^H K_c W_phi
+  // (W_phi the unit mode's contact motion; exact for a linear force).
   // Where K_c is zero (a cubic spring, an open contact) w0 itself is a pole of the receptance
   // (G is singular at the free mode): the guess moves off it by the force's own stiffening.
   {
@@ -345,7 +430,12 @@ NonlinearModeCurve trace_nonlinear_mode(const frf::LinearPart& linear, hbm::Nonl
       throw InputError("nlmodes.amplitude_start = " + std::to_string(a) +
                        ": the contacts carry no force at this amplitude of the linear mode (open): the reduced "
                        "equations have no solution there; start above the amplitude at which they close");
-    const double w2 = w0 * w0 - bphi.dot(curve.linear.contact_stiffness * bphi) + bphi.dot(f1.real()) / a;
+    // With a massless part the projection is on P phi, the motion (I + R K_c)^-1 P phi.
+    frf::SecondOrderForm so;
+    linear.second_order_form(1, so);
+    const Eigen::VectorXcd pphi = so.P * curve.linear.phi;
+    const Eigen::VectorXcd kb = curve.linear.contact_stiffness.cast<std::complex<double>>() * bphi;
+    const double w2 = w0 * w0 - pphi.dot(kb).real() + pphi.dot(f1).real() / a;
     x[n] = w2 > 0 ? std::sqrt(w2) : w0;
     if (std::abs(x[n] / w0 - 1) < kPoleOffset) x[n] = w0 * (1 + kPoleOffset);
   }
@@ -357,11 +447,74 @@ NonlinearModeCurve trace_nonlinear_mode(const frf::LinearPart& linear, hbm::Nonl
                          ") did not converge from the linear mode");
   }
   record(x, a, iterations);
-  Eigen::VectorXd y = to_y(x, a), y_prev;
-  double lambda_prev = lambda, step = settings.initial_step;
-  bool have_prev = false;
+
+  // Pseudo-arclength in z = ((W - W_s) / a, w, zeta, lambda = log10 a), scaled by S = (c_w, kMaxJump w0,
+  // kMaxJump w0, max_step): a unit step moves at most max_step decades in amplitude, kMaxJump
+  // of the frequency (and of zeta in units of w0) and one unit mode's contact motion, so the
+  // curve is resolved where it turns in amplitude (a contact that opens, a fold) as where it
+  // moves along it. Predictor: the secant (the amplitude direction at the linear start);
+  // corrector: Newton on the equations and t . (z - z_pred) = 0.
+  const int nz = n + 3;
+  Eigen::VectorXd scale(nz);
+  scale.head(n).setConstant(c_w);
+  scale[n] = scale[n + 1] = kMaxJump * w0;
+  scale[n + 2] = settings.max_step;
+  auto residual_scale = [&](double amp) {
+    Eigen::VectorXd rs(n + 2);
+    rs.head(n).setConstant(amp * c_w);
+    rs[n] = 1.0;
+    rs[n + 1] = amp * c_w;
+    return rs;
+  };
+  auto x_of = [&](const Eigen::VectorXd& z) { return to_x(z.head(n + 2), std::pow(10.0, z[n + 2])); };
+  const double ln10 = std::log(10.0);
+  auto corrector = [&](Eigen::VectorXd& z, const Eigen::VectorXd& z_pred, const Eigen::VectorXd& t, int& its) {
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    double last_step = std::numeric_limits<double>::infinity();
+    for (its = 0; its <= settings.max_newton_iterations; ++its) {
+      const double amp = std::pow(10.0, z[n + 2]);
+      const Eigen::VectorXd xz = to_x(z.head(n + 2), amp);
+      if (!eq.evaluate(xz, amp, r, &J)) return false;
+      const Eigen::VectorXd rs = residual_scale(amp);
+      const Eigen::VectorXd r_scaled = r.cwiseQuotient(rs);
+      const double arc = t.dot((z - z_pred).cwiseQuotient(scale));
+      const double norm = std::max(r_scaled.lpNorm<Eigen::Infinity>(), std::abs(arc));
+      if (norm <= settings.tolerance || (last_step <= kStagnation && norm <= kResidualFloor)) return true;
+      if (its == settings.max_newton_iterations) break;
+      // dx/dy = diag(a (W), 1, 1); dr/dlambda = ln10 (J_W (x_W - W_s) - e_a (r_a + 1)), and the
+      // scaled rows r / (a c_w) also move with a.
+      Eigen::MatrixXd A(nz, nz);
+      Eigen::VectorXd dxdy = Eigen::VectorXd::Ones(n + 2);
+      dxdy.head(n).setConstant(amp);
+      A.topLeftCorner(n + 2, n + 2) =
+          rs.cwiseInverse().asDiagonal() * J * (dxdy.cwiseProduct(scale.head(n + 2))).asDiagonal();
+      Eigen::VectorXd dr = ln10 * (J.leftCols(n) * (xz.head(n) - w_static));
+      dr[n] -= ln10 * (r[n] + 1.0);
+      Eigen::VectorXd drs = dr.cwiseQuotient(rs);
+      drs.head(n) -= ln10 * r_scaled.head(n);
+      drs[n + 1] -= ln10 * r_scaled[n + 1];
+      A.col(n + 2).head(n + 2) = drs * scale[n + 2];
+      A.row(n + 2) = t.transpose();
+      Eigen::VectorXd rhs(nz);
+      rhs.head(n + 2) = -r_scaled;
+      rhs[n + 2] = -arc;
+      const Eigen::VectorXd dz = Eigen::PartialPivLU<Eigen::MatrixXd>(A).solve(rhs);
+      if (!dz.allFinite()) return false;
+      last_step = dz.lpNorm<Eigen::Infinity>();
+      z += dz.cwiseProduct(scale);
+    }
+    return false;
+  };
+  Eigen::VectorXd z(nz);
+  z.head(n + 2) = to_y(x, a);
+  z[n + 2] = lambda;
+  Eigen::VectorXd tangent = Eigen::VectorXd::Unit(nz, n + 2);  // scaled, unit
+  double step = settings.initial_step / settings.max_step;
+  const double min_step = settings.min_step / settings.max_step;
+  const double cos_max_turn = std::cos(kMaxTurnDeg * std::numbers::pi / 180.0);
   while (true) {
-    if (lambda >= lambda_end - 1e-12) {
+    if (z[n + 2] >= lambda_end - 1e-12) {
       curve.reached_end = true;
       curve.message = "reached amplitude_end";
       break;
@@ -370,26 +523,49 @@ NonlinearModeCurve trace_nonlinear_mode(const frf::LinearPart& linear, hbm::Nonl
       curve.message = "max_points reached";
       break;
     }
-    const double h = std::min(step, lambda_end - lambda), lambda_new = lambda + h, a_new = std::pow(10.0, lambda_new);
-    Eigen::VectorXd y_pred = y;
-    if (have_prev) y_pred += (h / (lambda - lambda_prev)) * (y - y_prev);
-    Eigen::VectorXd x_new = to_x(y_pred, a_new);
-    if (newton(x_new, a_new, iterations)) {
-      y_prev = y;
-      lambda_prev = lambda;
-      have_prev = true;
-      y = to_y(x_new, a_new);
-      lambda = lambda_new;
-      a = a_new;
-      record(x_new, a, iterations);
-      if (iterations <= kEasyIterations) step = std::min(step * kGrowth, settings.max_step);
+    if (z[n + 2] < lambda - kBelowStart) {
+      std::ostringstream m;
+      m << "the mode's branch turned back in amplitude and fell a decade below amplitude_start (amplitude "
+        << std::pow(10.0, z[n + 2]) << ")";
+      curve.message = m.str();
+      break;
+    }
+    double h = step;
+    // The last step lands on amplitude_end when the branch heads there.
+    const bool last = tangent[n + 2] > 0 && z[n + 2] + h * tangent[n + 2] * scale[n + 2] >= lambda_end;
+    if (last) h = (lambda_end - z[n + 2]) / (tangent[n + 2] * scale[n + 2]);
+    const Eigen::VectorXd z_pred = z + h * tangent.cwiseProduct(scale);
+    Eigen::VectorXd z_new = z_pred;
+    bool ok = false;
+    if (last) {
+      Eigen::VectorXd x_end = x_of(z_pred);
+      ok = newton(x_end, settings.amplitude_end, iterations);
+      if (ok) z_new << to_y(x_end, settings.amplitude_end), lambda_end;
+    } else {
+      ok = corrector(z_new, z_pred, tangent, iterations);
+    }
+    Eigen::VectorXd secant = (z_new - z).cwiseQuotient(scale);
+    const double length = secant.norm();
+    if (ok && length > 0) {
+      secant /= length;
+      // A step whose secant turns too far from the tangent has jumped to another branch.
+      if (secant.dot(tangent) < cos_max_turn && h > min_step) ok = false;
+    } else {
+      ok = false;
+    }
+    if (ok) {
+      z = z_new;
+      tangent = secant;
+      record(x_of(z), std::pow(10.0, z[n + 2]), iterations);
+      if (iterations <= kEasyIterations) step = std::min(step * kGrowth, 1.0);
     } else {
       ++curve.rejected_steps;
-      step *= 0.5;
-      if (step < settings.min_step) {
-        std::ostringstream s;
-        s << "step below min_step at amplitude " << a << ": the corrector fails beyond";
-        curve.message = s.str();
+      step = 0.5 * h;
+      if (step < min_step) {
+        std::ostringstream m;
+        m << "step below min_step at amplitude " << std::pow(10.0, z[n + 2])
+          << ": beyond it the corrector fails or the solution jumps to another branch";
+        curve.message = m.str();
         break;
       }
     }

@@ -22,8 +22,13 @@
 // of (W / a, w, zeta) in lambda, Newton corrector on the square (n + 2) system scaled by
 // (a c_W, w_0, w_0) (c_W the largest contact motion of the unit linear mode), step in
 // lambda grown (x 1.5) after an easy corrector and halved after a failed one. Start: the
-// linear mode of M, K + B^H K_c B (K_c the force's first-harmonic stiffness at W = 0: the
-// contact springs when stuck and closed, nothing when open), zeta_0 = phi^T C phi.
+// linear mode of the second-order form (frf::SecondOrderForm of harmonic 1: M, C, K, P and
+// the massless part R) with the contacts linearized about W = 0: K + P^H K_c (I + R K_c)^-1 P
+// (K_c the force's first-harmonic stiffness at W = 0: the contact springs when stuck and
+// closed, nothing when open; R, the residual flexibility of an FE sector, condensed in),
+// zeta_0 = phi^H C phi. For a lumped model P = B, R = 0; for an FE sector (frf/sector.hpp) the
+// coordinates are the modes of the engine order's harmonic index, complex, and the mode is
+// the travelling wave of that index.
 //
 // Usage:
 //   forced::NonlinearModeSettings s;  s.amplitude_start = 1e-6;  s.amplitude_end = 1e-2;
@@ -55,9 +60,11 @@ struct NonlinearModeSettings {
 
 /// The linear mode the nonlinear mode starts from.
 struct LinearMode {
-  double omega = 0.0;                 ///< [rad/s]
-  double zeta = 0.0;                  ///< phi^T C phi [1/s]
-  Eigen::VectorXd phi;                ///< mass-normalised
+  double omega = 0.0;    ///< [rad/s]
+  double zeta = 0.0;     ///< phi^H C phi [1/s]
+  Eigen::VectorXcd phi;  ///< mass-normalised, in the second-order form's coordinates
+  /// W of the unit mode: (I + R K_c)^-1 P phi (c), its largest component real and positive
+  Eigen::VectorXcd contact_motion;
   Eigen::MatrixXd contact_stiffness;  ///< K_c (c x c) the mode was computed with
 };
 
@@ -126,10 +133,17 @@ class NonlinearModeEquations {
   std::vector<frf::DampedReceptance> rec_;
 };
 
-/// The linear mode `mode` (1-based) of the model linearized about W = 0 (see above). Throws
-/// InputError when the linear part has no second-order form without massless part, or the
-/// mode does not exist.
-LinearMode linear_mode(const frf::LinearPart& linear, hbm::NonlinearForce& force, int mode);
+/// The linear mode `mode` (1-based) of the model linearized about `state` (W; empty: W = 0;
+/// see above). Throws InputError when the linear part has no second-order form or the mode
+/// does not exist.
+LinearMode linear_mode(const frf::LinearPart& linear, hbm::NonlinearForce& force, int mode,
+                       const Eigen::VectorXd& state = Eigen::VectorXd());
+
+/// The contacts' static state without vibration: W with only harmonic 0, solving
+/// W_0 + G_0 (F_0(W) - F_s) = 0 (docs/physics.md section 3): W = 0 when every pair carries its
+/// preload in the static state, else the preload relaxed through the static flexibility.
+/// Throws NumericalError when Newton does not converge.
+Eigen::VectorXd static_contact_state(const frf::LinearPart& linear, hbm::NonlinearForce& force);
 
 /// Traces the nonlinear mode (see above). Throws NumericalError when the first point does
 /// not converge; a later failure ends the curve (reached_end false, message says why).

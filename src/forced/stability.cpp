@@ -84,7 +84,7 @@ linalg::DenseEigen hill_eigen(const Eigen::MatrixXcd& companion, const std::vect
 double FloquetResult::spectral_radius(double frequency_hz) const { return std::exp(max_real / frequency_hz); }
 
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
-                                ExponentSelection selection, int max_size) {
+                                ExponentSelection selection, int max_size, bool allow_massless_mean) {
   FloquetResult out;
   const frf::LinearPart& linear = equations.linear_part();
   const hbm::HarmonicLayout& layout = equations.pair_layout();
@@ -97,7 +97,7 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   for (int n = 0; n <= h; ++n)
     if (!linear.second_order_form(n, forms[static_cast<std::size_t>(n)])) {
       out.reason =
-          "the linear part has no second-order form: Hill's method is implemented for lumped models "
+          "the linear part has no second-order form (lumped models and FE sectors have one) "
           "(docs/physics.md section 9)";
       return out;
     }
@@ -111,6 +111,14 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   if (out.hill_size > max_size) {
     out.reason = "the Hill eigenproblem would be " + std::to_string(out.hill_size) + " wide (2 DOFs (2H + 1)), above " +
                  std::to_string(max_size) + " (forced/stability.hpp kMaxHillSize)";
+    return out;
+  }
+  const bool massless_mean = form(0).M.rows() != form(1).M.rows();
+  if (massless_mean && !allow_massless_mean) {
+    out.reason =
+        "not analysed for this model: its harmonic 0 is massless (an FE sector: the static flexibility), and "
+        "Hill's method is validated for lumped models only; on the FE sector its verdict changes with H "
+        "(docs/physics.md section 9)";
     return out;
   }
   out.available = true;
@@ -179,6 +187,11 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   companion.bottomLeftCorner(s, s) = -a2_lu.solve(a0);
   companion.bottomRightCorner(s, s) = -a2_lu.solve(a1);
   if (!companion.allFinite()) throw NumericalError("the Hill matrix is not finite");
+  // The symmetric copy of an exponent has its eigenvector on harmonic 0's block: a model whose
+  // harmonic 0 has other (fewer) DOFs than harmonic 1 (an FE sector: harmonic 0 is static,
+  // massless) has no such copy, and the exponents nearest the real axis are taken instead.
+  if (massless_mean) selection = ExponentSelection::imaginary;
+  out.selection = selection;
   const bool vectors = selection == ExponentSelection::symmetry;
   // Hill problems are a few hundred wide: OpenBLAS's threads inside LAPACK cost more than they
   // save there (stress model 7, Hill size 190: 76 s threaded against 21 s serial on a busy

@@ -19,7 +19,14 @@
 // the copies whose eigenvectors crowd the outer harmonics. Selection:
 //   symmetry  (default) the exponents whose eigenvector's harmonic centroid
 //             sum_k k |q_k|^2 / sum_k |q_k|^2 lies within half a harmonic of 0;
-//   imaginary the 2 m exponents nearest the real axis (m = size of the k = 1 block).
+//   imaginary the 2 m exponents nearest the real axis (m = size of the k = 1 block); used
+//             whenever the k = 0 block has another size than k = 1 (an FE sector in modal
+//             coordinates: k = 0 is massless, its modes all in R, so no exponent's copy lives
+//             there; the selected ones are those of the modes near resonance and the real
+//             exponents of folds).
+// FE sector (frf::SectorLinearPart): modal coordinates of the harmonic index of each k (the
+// perturbation keeps the response's travelling-wave pattern: a perturbation of another nodal
+// diameter is not analysed), the residual flexibility as the massless R above.
 // The point is unstable when the largest real part of the selected exponents exceeds
 // kNeutralTolerance w. Floquet multipliers are exp(lambda T).
 #include <Eigen/Core>
@@ -51,13 +58,21 @@ struct FloquetResult {
   std::vector<std::complex<double>> exponents;
   double max_real = 0.0;  ///< Re of the first one [1/s]
   int hill_size = 0;      ///< dimension of the companion eigenproblem
+  /// The selection used: `imaginary` whenever harmonic 0 has other DOFs than harmonic 1 (an
+  /// FE sector, whose harmonic 0 is the massless static flexibility): there the symmetric
+  /// copy does not exist.
+  ExponentSelection selection = ExponentSelection::symmetry;
   /// The largest Floquet multiplier modulus, exp(max_real T).
   double spectral_radius(double frequency_hz) const;
 };
 
-/// The Floquet exponents of the solution w of `equations` at frequency f [Hz].
+/// The Floquet exponents of the solution w of `equations` at frequency f [Hz]. A model whose
+/// harmonic 0 has no dynamic DOFs (an FE sector) is not analysed (available false, reason says
+/// why) unless allow_massless_mean: its exponents are exact for stuck contacts (tests) but
+/// with friction or separation its verdicts change with H (docs/physics.md section 9).
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
-                                ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize);
+                                ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize,
+                                bool allow_massless_mean = false);
 
 /// Where the stability changes between two neighbouring points of a branch.
 struct StabilityChange {

@@ -189,6 +189,69 @@ std::vector<double> SectorLinearPart::resonances_hz() const {
   return f;
 }
 
+bool SectorLinearPart::second_order_form(int n, SecondOrderForm& out) const {
+  const int c = n_contact();
+  if (n == 0) {
+    out.M.resize(0, 0);
+    out.C.resize(0, 0);
+    out.K.resize(0, 0);
+    out.P.resize(c, 0);
+    out.R = static_.flex.topLeftCorner(c, c);
+    return true;
+  }
+  const IndexData& d = dynamic_.at(harmonic_index(n));
+  const Eigen::Index m = d.omega.size();
+  out.M = Eigen::MatrixXd::Identity(m, m);
+  out.C = (2.0 * forcing_.damping_ratio * d.omega).asDiagonal();
+  out.K = d.omega.cwiseAbs2().asDiagonal();
+  out.P = d.psi.topRows(c);
+  out.R = d.flex.topLeftCorner(c, c);
+  return true;
+}
+
+bool SectorLinearPart::damped_harmonic(int n, double w, double zeta, bool with_norm, DampedReceptance& out) const {
+  const int c = n_contact();
+  if (n == 0) {
+    out.G = static_.flex.topLeftCorner(c, c);
+    out.dG_dw = out.dG_dzeta = Eigen::MatrixXcd::Zero(c, c);
+    out.H = static_.flex.block(c, 0, 3, c);
+    return out.G.allFinite();
+  }
+  const IndexData& d = dynamic_.at(harmonic_index(n));
+  const Eigen::Index m = d.omega.size();
+  const double big_w = n * w, z = forcing_.damping_ratio;
+  // 1/den_r and its derivatives: den_r = w_r^2 - W^2 + i W (2 z w_r - zeta), W = n w.
+  Eigen::VectorXcd inv(m), dinv_dw(m), dinv_dz(m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const Complex den(d.omega[r] * d.omega[r] - big_w * big_w, big_w * (2.0 * z * d.omega[r] - zeta));
+    const Complex dden_dw = static_cast<double>(n) * Complex(-2.0 * big_w, 2.0 * z * d.omega[r] - zeta);
+    const Complex dden_dz(0.0, -big_w);
+    inv[r] = 1.0 / den;
+    dinv_dw[r] = -dden_dw * inv[r] * inv[r];
+    dinv_dz[r] = -dden_dz * inv[r] * inv[r];
+  }
+  const auto psi_c = d.psi.topRows(c);
+  out.G = psi_c * inv.asDiagonal() * psi_c.adjoint() + d.flex.topLeftCorner(c, c);
+  out.dG_dw = psi_c * dinv_dw.asDiagonal() * psi_c.adjoint();
+  out.dG_dzeta = psi_c * dinv_dz.asDiagonal() * psi_c.adjoint();
+  out.H = d.psi.middleRows(c, 3) * inv.asDiagonal() * psi_c.adjoint() + d.flex.block(c, 0, 3, c);
+  if (with_norm && n == 1) {
+    // q = Phi eta, eta = -diag(inv) psi_c^H F: q^H M q = F^H psi_c diag(|inv|^2) psi_c^H F.
+    Eigen::VectorXd n2(m), dn2_dw(m), dn2_dz(m);
+    for (Eigen::Index r = 0; r < m; ++r) {
+      n2[r] = std::norm(inv[r]);
+      dn2_dw[r] = 2.0 * (std::conj(inv[r]) * dinv_dw[r]).real();
+      dn2_dz[r] = 2.0 * (std::conj(inv[r]) * dinv_dz[r]).real();
+    }
+    out.N = psi_c * n2.asDiagonal() * psi_c.adjoint();
+    out.dN_dw = psi_c * dn2_dw.asDiagonal() * psi_c.adjoint();
+    out.dN_dzeta = psi_c * dn2_dz.asDiagonal() * psi_c.adjoint();
+    // e = X_1^H f over the modes: psi_c diag(conj(inv)) (row c + 3 of psi)^H.
+    out.e = psi_c * inv.conjugate().asDiagonal() * d.psi.row(c + 3).adjoint();
+  }
+  return out.G.allFinite();
+}
+
 std::string SectorLinearPart::describe() const {
   std::ostringstream s;
   s << "FE sector (Nb = " << sectors_ << ", engine order " << forcing_.engine_order << ", harmonic indices";

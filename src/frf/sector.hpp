@@ -80,6 +80,15 @@ class SectorLinearPart : public LinearPart {
   std::string describe() const override;
   /// The modal frequencies of harmonic index h_1 (the engine order's).
   std::vector<double> resonances_hz() const override;
+  /// Modal coordinates of h_n (mass-normalised modes): M = I, C = diag(2 z w_r),
+  /// K = diag(w_r^2), P = the modes' contact rows, R = the residual flexibility's contact block
+  /// (massless). n = 0: no modes, R = the static flexibility: the mean of a perturbation is
+  /// taken quasi-statically, as the harmonic balance takes the mean of the motion.
+  bool second_order_form(int n, SecondOrderForm& out) const override;
+  /// The same modal form with each mode's denominator w_r^2 - W^2 + i W (2 z w_r - zeta); N and
+  /// e over the modes only (the residual part is massless; e is the modal part's projection
+  /// of the excitation). n = 0: the static flexibility, no derivatives.
+  bool damped_harmonic(int n, double w, double zeta, bool with_norm, DampedReceptance& out) const override;
 
   /// Harmonic index of temporal harmonic n.
   int harmonic_index(int n) const;

@@ -101,6 +101,16 @@ Eigen::VectorXcd ContactEvaluator::static_load() const {
   return f;
 }
 
+double ContactEvaluator::rest_displacement() const {
+  double d = 0.0;
+  for (const auto& pp : pairs_) {
+    if (pp.tangential_stiffness > 0.0)
+      d = std::max(d, pp.friction_coefficient * std::abs(pp.normal_preload) / pp.tangential_stiffness);
+    if (pp.normal_stiffness > 0.0) d = std::max(d, std::abs(pp.normal_preload) / pp.normal_stiffness);
+  }
+  return std::isfinite(d) ? d : 0.0;
+}
+
 void ContactEvaluator::to_time(const double* w, Workspace& ws) {
   const int m = layout_.per_direction();
   ws.w.setZero();

@@ -87,6 +87,8 @@ class ContactEvaluator : public NonlinearForce {
   /// The normal max(0, N0) of every pair with PairParameters::preload_in_equilibrium (3D
   /// models), else 0 (as forced::ReducedEquations).
   Eigen::VectorXcd static_load() const override;
+  /// The largest of mu |N0| / kt and |N0| / kn over the pairs.
+  double rest_displacement() const override;
   /// The same with an explicit Jacobian method (comparisons and benchmarks).
   EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f, std::vector<Eigen::MatrixXd>* jacobian,
                             JacobianMethod method);

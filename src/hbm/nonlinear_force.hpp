@@ -31,6 +31,10 @@ class NonlinearForce {
   /// structure already carries about the state W = 0 is measured from (docs/physics.md
   /// section 3); the static harmonic balances F_0 - F_s. Default: none.
   virtual Eigen::VectorXcd static_load() const { return Eigen::VectorXcd::Zero(3 * n_pairs()); }
+  /// A displacement on which the force's behaviour at rest changes (a contact's slip or
+  /// lift-off displacement; the largest over the pairs) [m], for probing the force near rest;
+  /// 0: none (a smooth force).
+  virtual double rest_displacement() const { return 0.0; }
 };
 
 }  // namespace shroudsim::hbm

@@ -147,6 +147,7 @@ struct NlmodesSection {
   int mode;  ///< 1-based linear mode index
   int max_points;
   std::vector<double> synthesis_scales;  ///< excitation scales of the synthesized curves
+  bool compare_hb;                       ///< also the full harmonic balance at each scale
 };
 
 /// One harmonic of a prescribed motion: x(t) += c cos(n w t) + s sin(n w t).

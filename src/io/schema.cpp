@@ -705,7 +705,8 @@ Schema declare() {
       .range(1, 1'000'000);
 
   d.section("nlmodes",
-            "only for `shroudsim nlmodes` (lumped models): the nonlinear mode by the extended periodic motion concept");
+            "only for `shroudsim nlmodes` (lumped models and FE sectors): the nonlinear mode by the extended periodic "
+            "motion concept");
   auto& a_start = d.number("nlmodes.amplitude_start", at(&Case::nlmodes, &NlmodesSection::amplitude_start), 1e-6,
                            "m kg^0.5",
                            "smallest modal amplitude a (the fundamental's q_1^H M q_1 = a^2): where the contacts "
@@ -728,6 +729,10 @@ Schema declare() {
       .rule("every scale > 0 and finite", [](const Case&, const std::vector<double>& v) {
         return std::all_of(v.begin(), v.end(), [](double f) { return f > 0.0 && std::isfinite(f); });
       });
+  d.boolean("nlmodes.compare_hb", at(&Case::nlmodes, &NlmodesSection::compare_hb), false,
+            "also trace the full harmonic-balance forced response at every synthesis scale over the "
+            "[continuation] range and compare its largest peak with the synthesized one "
+            "(nlmodes_compare.csv, run.json nlmodes.comparison)");
 
   d.section("motion", "only for `shroudsim contact`: prescribed relative motion, rows [harmonic, cosine, sine] in m");
   motion(d, "motion.x", &MotionSection::x, {{1, 1e-5, 0.0}}, "relative tangential motion x(t)");

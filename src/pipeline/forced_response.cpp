@@ -100,7 +100,10 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
     return out;
   }
   s["method"] = "hill";
-  s["selection"] = "symmetry";
+  bool imaginary = false;
+  for (const auto& f : out)
+    imaginary = imaginary || (f.available && f.selection == forced::ExponentSelection::imaginary);
+  s["selection"] = imaginary ? "imaginary" : "symmetry";
   s["neutral_tolerance"] = forced::kNeutralTolerance;
   s["hill_size"] = size;
   s["unstable_points"] = unstable;

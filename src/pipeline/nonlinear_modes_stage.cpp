@@ -5,8 +5,10 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "forced/frequency_response.hpp"
 #include "forced/mode_synthesis.hpp"
 #include "forced/nonlinear_modes.hpp"
+#include "forced/reduced_equations.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "io/output.hpp"
 #include "pipeline/forced_model.hpp"
@@ -38,17 +40,13 @@ void write_nlmodes_csv(const std::filesystem::path& file, const forced::Nonlinea
 NonlinearModesOutcome run_nonlinear_modes(Context& ctx) {
   const io::Case& c = ctx.config;
   const log::Stopwatch clock;
-  if (c.structure.type != io::StructureType::lumped)
-    throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
-                     "\": `nlmodes` needs a lumped model (structure.type = \"lumped\"); the FE sector is not "
-                     "supported yet");
   if (c.hbm.harmonics_auto)
     throw InputError(c.where("hbm.harmonics") +
                      ": hbm.harmonics = \"auto\" violates: a number for `nlmodes` (the search is the forced "
                      "response's)");
   if (c.hbm.time_samples_auto)
     throw InputError(c.where("hbm.time_samples") + ": hbm.time_samples = \"auto\" violates: a number for `nlmodes`");
-  ForcedModel model = make_lumped_model(c);
+  ForcedModel model = c.structure.type == io::StructureType::lumped ? make_lumped_model(c) : make_sector_model(ctx);
   hbm::ContactEvaluator contacts(evaluator_options(c, ctx.threads), model.pairs);
   forced::NonlinearModeSettings settings;
   settings.amplitude_start = c.nlmodes.amplitude_start;
@@ -110,6 +108,64 @@ NonlinearModesOutcome run_nonlinear_modes(Context& ctx) {
     peaks.push_back(e);
   }
   io::write_file_atomic(ctx.out_dir / "nlmodes_synthesis.csv", syn.str());
+
+  // The full harmonic balance at each scale over the case's range: its largest peak against
+  // the synthesized one (docs/physics.md section 10).
+  if (c.nlmodes.compare_hb) {
+    std::ostringstream cmp;
+    cmp << "scale,hb_frequency_hz,hb_amplitude_m,synthesis_frequency_hz,synthesis_amplitude_m,frequency_error,"
+           "amplitude_error,within_5_percent,hb_seconds,synthesis_seconds,hb_status\n";
+    auto& comparison = j["comparison"];
+    comparison = nlohmann::json::array();
+    const forced::FrequencyResponseSettings fs = frequency_response_settings(c);
+    const hbm::ContactEvaluatorOptions eo = evaluator_options(c, ctx.threads);
+    for (double s : c.nlmodes.synthesis_scales) {
+      const log::Stopwatch sc;
+      const forced::SynthesisPeak peak = forced::synthesis_peak(curve.points, s);
+      const double synthesis_seconds = sc.seconds();
+      hbm::ContactEvaluator hb_contacts(eo, model.pairs);
+      forced::ReducedEquations equations(*model.linear, hb_contacts);
+      equations.set_excitation_scale(s);
+      const log::Stopwatch hc;
+      nlohmann::json e = {{"scale", s}};
+      try {
+        const forced::FrequencyResponse response = forced::trace_frequency_response(fs, model, eo, equations);
+        e["hb_seconds"] = hc.seconds();
+        e["hb_status"] = continuation::to_string(response.summary.status);
+        const forced::ResponsePeak* top = nullptr;
+        for (const auto& p : response.peaks)
+          if (!top || p.amplitude_m > top->amplitude_m) top = &p;
+        if (top && peak.found) {
+          const double ef = peak.frequency_hz / top->frequency_hz - 1, ea = peak.amplitude / top->amplitude_m - 1;
+          const bool within = std::abs(ea) <= 0.05;
+          e["hb_peak_frequency_hz"] = top->frequency_hz;
+          e["hb_peak_amplitude_m"] = top->amplitude_m;
+          e["synthesis_peak_frequency_hz"] = peak.frequency_hz;
+          e["synthesis_peak_amplitude_m"] = peak.amplitude;
+          e["frequency_error"] = ef;
+          e["amplitude_error"] = ea;
+          e["within_5_percent"] = within;
+          cmp << io::format_number(s) << "," << io::format_number(top->frequency_hz) << ","
+              << io::format_number(top->amplitude_m) << "," << io::format_number(peak.frequency_hz) << ","
+              << io::format_number(peak.amplitude) << "," << io::format_number(ef) << "," << io::format_number(ea)
+              << "," << (within ? 1 : 0) << "," << io::format_number(hc.seconds()) << ","
+              << io::format_number(synthesis_seconds) << "," << e["hb_status"].get<std::string>() << "\n";
+          log::info("nlmodes: scale " + io::format_number(s) + ": HB peak " + io::format_number(top->amplitude_m) +
+                    " m at " + io::format_number(top->frequency_hz) + " Hz, synthesis " +
+                    io::format_number(peak.amplitude) + " m at " + io::format_number(peak.frequency_hz) + " Hz (" +
+                    io::format_number(100 * ea) + " %)");
+        } else {
+          e["note"] = top ? "the mode's amplitude range ends below this level's peak" : "the HB curve has no peak";
+        }
+      } catch (const NumericalError& err) {
+        e["hb_seconds"] = hc.seconds();
+        e["hb_status"] = "start_failed";
+        e["note"] = err.what();
+      }
+      comparison.push_back(e);
+    }
+    io::write_file_atomic(ctx.out_dir / "nlmodes_compare.csv", cmp.str());
+  }
   ctx.report.stage("nlmodes", clock.seconds());
   std::ostringstream msg;
   msg << "nlmodes: " << curve.points.size() << " points, " << j["linear_frequency_hz"].get<double>() << " Hz -> "

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "../common/coarse_sector.hpp"
+#include "../common/sector_contacts.hpp"
 #include "continuation/arclength.hpp"
 #include "cyclic/cyclic_sector.hpp"
 #include "forced/reduced_equations.hpp"
@@ -232,25 +233,9 @@ struct Sector : testing_support::CoarseSector {
   }
   frf::SectorLinearPart linear(bool residual) const {
     std::vector<frf::SectorContactPair> pairs;
-    for (const auto& [low, high] : mesh.shroud_pairs) {
-      frf::SectorContactPair p;
-      p.low_node = low;
-      p.high_node = high;
-      // Any orthonormal frame serves the algebra; the normal roughly circumferential.
-      const Eigen::Vector3d x = mesh.nodes.row(high);
-      Eigen::Vector3d n(-x.y(), x.x(), 0.0);
-      n.normalize();
-      p.frame.row(2) = n;
-      p.frame.row(0) = Eigen::Vector3d::UnitZ();
-      p.frame.row(1) = n.cross(Eigen::Vector3d::UnitZ());
-      pairs.push_back(p);
-    }
-    frf::SectorForcing forcing;
-    forcing.engine_order = 1;
-    forcing.excitation_node = mesh.n_nodes() / 2;
-    forcing.response_node = mesh.n_nodes() / 3;
-    forcing.force = Eigen::Vector3d(1.0, 1.0, 1.0);
-    forcing.residual_flexibility = residual;
+    for (const auto& [low, high] : mesh.shroud_pairs)
+      pairs.push_back(testing_support::circumferential_pair(mesh, low, high));
+    const frf::SectorForcing forcing = testing_support::test_forcing(mesh, residual);
     return frf::SectorLinearPart(
         *sector, bases, [&](int h) { return factors.at(h); }, pairs, forcing, 2);
   }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -61,9 +62,48 @@ TEST(NlmodesCli, BadKeysAreInputErrorsNamingTheKey) {
   r = s.run("nlmodes " + kJenkins + " --quiet --out out --set nlmodes.mode=2");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("nlmodes.mode"), std::string::npos) << r.err;
-  r = s.run("nlmodes " + std::string(SHROUDSIM_SOURCE_DIR) + "/cases/shrouded_blade.toml --quiet --out out");
+  r = s.run("nlmodes " + kJenkins + " --quiet --out out --set nlmodes.compare_hb=3");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("lumped"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nlmodes.compare_hb"), std::string::npos) << r.err;
+}
+
+TEST(NlmodesCli, TheDefaultWheelsModeRunsEndToEndAndMeetsItsHarmonicBalance) {
+  // cases/shrouded_wheel.toml on a coarse mesh with fewer modes and harmonics: the FE sector's
+  // nonlinear mode from stick into slip, and the synthesized peak at the case's excitation
+  // against the full harmonic balance (nlmodes.compare_hb).
+  Scratch s("nlmodes_wheel");
+  s.write("wheel.toml", slurp(fs::path(SHROUDSIM_SOURCE_DIR) / "cases" / "shrouded_wheel.toml"));
+  const CliResult r = s.run(
+      "nlmodes wheel.toml --out out --quiet --set geometry.element_order=1 --set geometry.mesh_size=0.0144 "
+      "--set modal.modes=10 --set hbm.harmonics=3 --set hbm.time_samples=128 --set nlmodes.synthesis_scales=[1.0] "
+      "--set nlmodes.compare_hb=true");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(s.dir() / "out" / "run.json"));
+  const auto& n = j["nlmodes"];
+  EXPECT_TRUE(n["reached_end"].get<bool>());
+  const auto rows = csv_rows(slurp(s.dir() / "out" / "nlmodes.csv"));
+  ASSERT_GT(rows.size(), 20u);
+  // Stuck at small amplitude: the linear mode with the contact springs, its modal damping.
+  EXPECT_NEAR(std::stod(rows[1][1]) / n["linear_frequency_hz"].get<double>(), 1.0, 1e-6);
+  // Friction damps it: the largest damping ratio well above the stuck one, the frequency lower.
+  EXPECT_GT(n["max_damping_ratio"].get<double>(), 5 * n["linear_damping_ratio"].get<double>());
+  EXPECT_LT(n["end_frequency_hz"].get<double>(), n["linear_frequency_hz"].get<double>());
+  ASSERT_EQ(n["comparison"].size(), 1u);
+  const auto& c = n["comparison"][0];
+  ASSERT_TRUE(c.contains("amplitude_error")) << c.dump();
+  EXPECT_TRUE(fs::exists(s.dir() / "out" / "nlmodes_compare.csv"));
+  std::printf(
+      "coarse wheel: %zu points, %.3f -> %.3f Hz, D max %.4f; peak HB %.4e m at %.3f Hz, synthesis %+.2e, %+.2e\n",
+      rows.size() - 1, n["linear_frequency_hz"].get<double>(), n["end_frequency_hz"].get<double>(),
+      n["max_damping_ratio"].get<double>(), c["hb_peak_amplitude_m"].get<double>(),
+      c["hb_peak_frequency_hz"].get<double>(), c["amplitude_error"].get<double>(), c["frequency_error"].get<double>());
+  // The single-mode synthesis is an approximation on the sector (measured here -4.8 % in
+  // amplitude and -4.9 % in frequency; on the shipped mesh -11 to -14 %, README): it must land
+  // on this resonance, not on another one.
+  constexpr double kSameResonance = 0.25;
+  EXPECT_LT(std::abs(c["amplitude_error"].get<double>()), kSameResonance) << c.dump();
+  EXPECT_LT(std::abs(c["frequency_error"].get<double>()), kSameResonance) << c.dump();
+  EXPECT_EQ(c["within_5_percent"].get<bool>(), std::abs(c["amplitude_error"].get<double>()) <= 0.05);
 }
 
 }  // namespace
