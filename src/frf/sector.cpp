@@ -292,7 +292,7 @@ std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
         SHROUDSIM_CHECK(loads[l].forces[n].size() == c, "contact forces of every pair");
         Eigen::VectorXcd y = Eigen::VectorXcd::Zero(c + 4);
         y.head(c) = -loads[l].forces[n];
-        if (n == 1) y(c + 3) = 1.0;
+        if (n == 1 && loads[l].excitation) y(c + 3) = 1.0;
         const Eigen::VectorXcd g = load_map * y;
         Eigen::VectorXcd ur;
         if (n == 0) {
@@ -303,7 +303,7 @@ std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
           Eigen::VectorXcd q(modal.size());
           for (Eigen::Index r = 0; r < modal.size(); ++r) {
             const double wr = basis->omega[r];
-            q[r] = modal[r] / Complex(wr * wr - big_w * big_w, 2.0 * z * wr * big_w);
+            q[r] = modal[r] / Complex(wr * wr - big_w * big_w, big_w * (2.0 * z * wr - loads[l].zeta));
             if (forcing.residual_flexibility) q[r] -= modal[r] / (wr * wr);
           }
           ur = basis->phi * q;

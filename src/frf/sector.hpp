@@ -115,6 +115,10 @@ class SectorLinearPart : public LinearPart {
 struct ShapeLoad {
   double w = 0.0;
   std::vector<Eigen::VectorXcd> forces;
+  /// The autonomous motion of a nonlinear mode (forced/nonlinear_modes.hpp): no excitation and
+  /// the artificial damping -zeta M, i.e. each mode's denominator w_r^2 - W^2 + i W (2 z w_r - zeta).
+  bool excitation = true;
+  double zeta = 0.0;  ///< [1/s]
 };
 
 /// The displacement harmonics U_n (n = 0..H) of every DOF of the sector (n_full, node-major

@@ -92,6 +92,11 @@ TEST(NlmodesCli, TheDefaultWheelsModeRunsEndToEndAndMeetsItsHarmonicBalance) {
   const auto& c = n["comparison"][0];
   ASSERT_TRUE(c.contains("amplitude_error")) << c.dump();
   EXPECT_TRUE(fs::exists(s.dir() / "out" / "nlmodes_compare.csv"));
+  // The shapes for ParaView: stuck start, largest damping, end; the mode moves the sector.
+  EXPECT_TRUE(fs::exists(s.dir() / "out" / "nlmodes.vtu"));
+  ASSERT_EQ(n["shapes"].size(), 3u);
+  for (const auto& shape : n["shapes"]) EXPECT_GT(shape["largest_displacement_m"].get<double>(), 0.0) << shape.dump();
+  EXPECT_EQ(n["shapes"][1]["damping_ratio"].get<double>(), n["max_damping_ratio"].get<double>());
   std::printf(
       "coarse wheel: %zu points, %.3f -> %.3f Hz, D max %.4f; peak HB %.4e m at %.3f Hz, synthesis %+.2e, %+.2e\n",
       rows.size() - 1, n["linear_frequency_hz"].get<double>(), n["end_frequency_hz"].get<double>(),

@@ -35,6 +35,9 @@ constexpr double kTruncation = 1e-5;
 // A stuck contact's Floquet exponents against the linear mode with the springs: the mode's
 // decay zeta/2 = phi^H C phi / 2 is exact only to first order in the damping (D = 1e-3).
 constexpr double kStuckExponent = 1e-6;
+// The shapes' contact rows against the solution's W: the Newton tolerance (1e-10 of the scaled
+// residual) times the receptances' conditioning.
+constexpr double kShapeTolerance = 1e-8;
 
 struct Sector : testing_support::CoarseSector {
   std::map<int, modal::ModalBasis> bases;
@@ -255,6 +258,47 @@ TEST(SectorNonlinearModes, FrictionModeBalancesItsEnergyPerCycle) {
   EXPECT_LT(worst, kEnergyBalance);
   EXPECT_GT(d_max, 2 * curve.points.front().damping_ratio);
   EXPECT_LT(curve.points.back().frequency_hz, curve.points.front().frequency_hz);  // softening in slip
+}
+
+TEST(SectorNonlinearModes, ModeShapesCarryTheModesContactMotion) {
+  // The shapes nlmodes writes (frf::sector_displacements without excitation, with -zeta M):
+  // their contact rows B_h U_n are the solution's contact motion W_n, at every point kind.
+  const Sector& f = sector();
+  const int harmonics = 2;
+  const frf::SectorLinearPart part = f.linear(harmonics);
+  std::vector<contact::PairParameters> pairs = stuck_pairs();
+  for (auto& p : pairs) p.friction_coefficient = 0.3, p.normal_preload = 2.0;
+  hbm::ContactEvaluator ev(options(harmonics, 64), pairs);
+  NonlinearModeSettings s;
+  s.amplitude_start = 1e-7;
+  s.amplitude_end = 1e-3;
+  const NonlinearModeCurve curve = trace_nonlinear_mode(part, ev, s);
+  ASSERT_TRUE(curve.reached_end) << curve.message;
+  NonlinearModeEquations eq(part, ev);
+  std::vector<frf::ShapeLoad> loads;
+  const std::vector<std::size_t> at = {0, curve.points.size() / 2, curve.points.size() - 1};
+  for (std::size_t i : at) {
+    Eigen::VectorXd force;
+    ev.evaluate(curve.points[i].w, force, nullptr);
+    frf::ShapeLoad load;
+    load.w = curve.points[i].omega;
+    load.zeta = curve.points[i].zeta;
+    load.excitation = false;
+    for (int n = 0; n <= harmonics; ++n)  // harmonic 0 about the static state (F_0 - F_s)
+      load.forces.push_back(n == 0 ? Eigen::VectorXcd(eq.complex_harmonic(force, 0) - ev.static_load())
+                                   : eq.complex_harmonic(force, n));
+    loads.push_back(load);
+  }
+  const auto u = frf::sector_displacements(
+      *f.sector, f.bases, [&](int h) { return f.factors.at(h); }, f.pairs, testing_support::test_forcing(f.mesh, true),
+      loads);
+  for (std::size_t l = 0; l < at.size(); ++l)
+    for (int n = 0; n <= harmonics; ++n) {
+      const Eigen::VectorXcd w = frf::contact_rows(f.pairs, *f.sector, n, f.sector->n_full()) * u[l][n];
+      const Eigen::VectorXcd expected = eq.complex_harmonic(curve.points[at[l]].w, n);
+      EXPECT_LT((w - expected).norm(), kShapeTolerance * std::max(expected.norm(), curve.points[at[l]].w.norm()))
+          << "point " << at[l] << ", harmonic " << n;
+    }
 }
 
 }  // namespace
