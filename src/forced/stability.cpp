@@ -84,7 +84,7 @@ linalg::DenseEigen hill_eigen(const Eigen::MatrixXcd& companion, const std::vect
 double FloquetResult::spectral_radius(double frequency_hz) const { return std::exp(max_real / frequency_hz); }
 
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
-                                ExponentSelection selection, int max_size, bool allow_massless_mean) {
+                                ExponentSelection selection, int max_size, bool allow_sector) {
   FloquetResult out;
   const frf::LinearPart& linear = equations.linear_part();
   const hbm::HarmonicLayout& layout = equations.pair_layout();
@@ -114,11 +114,11 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
     return out;
   }
   const bool massless_mean = form(0).M.rows() != form(1).M.rows();
-  if (massless_mean && !allow_massless_mean) {
+  if (form(1).own_coordinates_per_harmonic && !allow_sector) {
     out.reason =
-        "not analysed for this model: its harmonic 0 is massless (an FE sector: the static flexibility), and "
-        "Hill's method is validated for lumped models only; on the FE sector its verdict changes with H "
-        "(docs/physics.md section 9)";
+        "not analysed for an FE sector (validated for lumped models): each harmonic lives in its own harmonic "
+        "index, so the exponents have no copies to select from and the resonant family's complex exponents "
+        "would go unjudged (docs/physics.md section 9)";
     return out;
   }
   out.available = true;

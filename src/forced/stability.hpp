@@ -66,13 +66,13 @@ struct FloquetResult {
   double spectral_radius(double frequency_hz) const;
 };
 
-/// The Floquet exponents of the solution w of `equations` at frequency f [Hz]. A model whose
-/// harmonic 0 has no dynamic DOFs (an FE sector) is not analysed (available false, reason says
-/// why) unless allow_massless_mean: its exponents are exact for stuck contacts (tests) but
-/// with friction or separation its verdicts change with H (docs/physics.md section 9).
+/// The Floquet exponents of the solution w of `equations` at frequency f [Hz]. An FE sector
+/// (frf::SecondOrderForm::own_coordinates_per_harmonic) is not analysed (available false,
+/// reason says why) unless allow_sector: its exponents are exact for stuck contacts (tests),
+/// but the selection does not yet judge every exponent (docs/physics.md section 9).
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
                                 ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize,
-                                bool allow_massless_mean = false);
+                                bool allow_sector = false);
 
 /// Where the stability changes between two neighbouring points of a branch.
 struct StabilityChange {

@@ -89,6 +89,12 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
   {
     const Eigen::SparseMatrix<Complex> ct = projected(0);
     static_.flex = static_flexibility(0, ct);
+    // With the modes of index 0 at hand, harmonic 0's second-order form is dynamic (the
+    // Floquet analysis: a perturbation's mean oscillates at lambda, not at 0).
+    if (auto it = bases.find(0); it != bases.end()) {
+      static_.omega = it->second.omega;
+      static_.psi = ct * it->second.phi;
+    }
   }
   for (int h : needed) {
     auto it = bases.find(h);
@@ -191,12 +197,16 @@ std::vector<double> SectorLinearPart::resonances_hz() const {
 
 bool SectorLinearPart::second_order_form(int n, SecondOrderForm& out) const {
   const int c = n_contact();
+  out.own_coordinates_per_harmonic = true;
   if (n == 0) {
-    out.M.resize(0, 0);
-    out.C.resize(0, 0);
-    out.K.resize(0, 0);
-    out.P.resize(c, 0);
+    const Eigen::Index m = static_.omega.size();
+    out.M = Eigen::MatrixXd::Identity(m, m);
+    out.C = (2.0 * forcing_.damping_ratio * static_.omega).asDiagonal();
+    out.K = static_.omega.cwiseAbs2().asDiagonal();
+    out.P = static_.psi.topRows(c);
     out.R = static_.flex.topLeftCorner(c, c);
+    for (Eigen::Index r = 0; r < m; ++r)
+      out.R -= out.P.col(r) * out.P.col(r).adjoint() / (static_.omega[r] * static_.omega[r]);
     return true;
   }
   const IndexData& d = dynamic_.at(harmonic_index(n));
