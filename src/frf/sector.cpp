@@ -203,7 +203,7 @@ bool SectorLinearPart::second_order_form(int n, SecondOrderForm& out) const {
     out.M = Eigen::MatrixXd::Identity(m, m);
     out.C = (2.0 * forcing_.damping_ratio * static_.omega).asDiagonal();
     out.K = static_.omega.cwiseAbs2().asDiagonal();
-    out.P = static_.psi.topRows(c);
+    out.P = m > 0 ? Eigen::MatrixXcd(static_.psi.topRows(c)) : Eigen::MatrixXcd(c, 0);
     out.R = static_.flex.topLeftCorner(c, c);
     for (Eigen::Index r = 0; r < m; ++r)
       out.R -= out.P.col(r) * out.P.col(r).adjoint() / (static_.omega[r] * static_.omega[r]);
