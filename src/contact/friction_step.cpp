@@ -100,15 +100,19 @@ void exact_linear_step_t(S e0x, S e0y, const S& dwx, const S& dwy, const S& a0, 
     projected = true;
   }
   const S dwsq = dwx * dwx + dwy * dwy;
-  if (!(val(dwsq) > 0.0)) {  // no tangential motion: stick (|e0| <= a0 <= ... see a1 check)
-    e1x = e0x;
-    e1y = e0y;
+  if (!(val(dwsq) > 0.0)) {
+    // No tangential motion: stick, e1 = e0 + dw (dw is zero in value, not in derivative: the
+    // stuck stiffness is de1/ddw = I), unless the radius shrinks below |e0| (then on it).
+    e1x = e0x + dwx;
+    e1y = e0y + dwy;
     const S n1sq = e1x * e1x + e1y * e1y;
     if (val(n1sq) > val(a1) * val(a1)) {
       const S n1 = sqrt(n1sq);
       e1x = a1 * e1x / n1;
       e1y = a1 * e1y / n1;
+      return;
     }
+    stuck = !projected;
     return;
   }
   const S da = a1 - a0;

@@ -165,15 +165,57 @@ bool ReflectionWatch::observe(const Eigen::VectorXd& y, double step,
 Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& options, const BranchPoint& from,
                         double step, const std::function<double(const Eigen::VectorXd&, double)>& g,
                         double s_tolerance) {
+  return locate_maximum(residual, options, from, 0.0, step, g, s_tolerance);
+}
+
+std::vector<Extremum> sample_along(ParametricResidual& residual, const ArclengthOptions& options,
+                                   const BranchPoint& from, const std::vector<double>& s,
+                                   const std::function<double(const Eigen::VectorXd&, double)>& g) {
+  int evaluations = 0;
+  ScaledSystem sys(residual, options, &evaluations);
+  const Eigen::VectorXd y0 = sys.to_scaled(from.x, from.lambda);
+  const Eigen::VectorXd& t0 = from.tangent;
+  std::vector<Extremum> out;
+  out.reserve(s.size());
+  Eigen::VectorXd y_last;
+  double s_last = 0.0;
+  for (double sj : s) {
+    const Eigen::VectorXd y_pred = y0 + sj * t0;
+    // The previous solution moved onto this hyperplane (t0 is a unit vector).
+    Eigen::VectorXd y = y_last.size() ? Eigen::VectorXd(y_last + (sj - s_last) * t0) : y_pred;
+    double rnorm = 0.0;
+    const int before = evaluations;
+    Extremum e;
+    e.s = sj;
+    if (correct(sys, y, t0, y_pred, rnorm) >= 0) {
+      e.found = true;
+      e.x = sys.x_of(y);
+      e.lambda = sys.lambda_of(y);
+      e.value = g(e.x, e.lambda);
+      y_last = y;
+      s_last = sj;
+    } else {
+      y_last.resize(0);
+    }
+    e.evaluations = evaluations - before;
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& options, const BranchPoint& from,
+                        double s_lo, double s_hi, const std::function<double(const Eigen::VectorXd&, double)>& g,
+                        double s_tolerance, const Extremum* near) {
   Extremum best;
   int evaluations = 0;
   ScaledSystem sys(residual, options, &evaluations);
   const Eigen::VectorXd y0 = sys.to_scaled(from.x, from.lambda);
   const Eigen::VectorXd& t0 = from.tangent;
   // -g at arclength s (infinity where the corrector fails).
+  const Eigen::VectorXd y_near = near && near->found ? sys.to_scaled(near->x, near->lambda) : Eigen::VectorXd();
   auto f = [&](double s) {
     const Eigen::VectorXd y_pred = y0 + s * t0;
-    Eigen::VectorXd y = y_pred;
+    Eigen::VectorXd y = y_near.size() ? Eigen::VectorXd(y_near + (s - near->s) * t0) : y_pred;
     double rnorm = 0.0;
     if (correct(sys, y, t0, y_pred, rnorm) < 0) return std::numeric_limits<double>::infinity();
     const Eigen::VectorXd x = sys.x_of(y);
@@ -181,9 +223,9 @@ Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& op
     if (!best.found || v > best.value) best = Extremum{true, s, x, lambda, v, 0};
     return -v;
   };
-  // Brent's minimization of f on [0, step] (golden section with parabolic steps).
-  const double golden = 0.5 * (3.0 - std::sqrt(5.0)), tol = s_tolerance * step;
-  double a = 0.0, b = step, x = a + golden * (b - a), w = x, v = x, fx = f(x), fw = fx, fv = fx;
+  // Brent's minimization of f on [s_lo, s_hi] (golden section with parabolic steps).
+  const double golden = 0.5 * (3.0 - std::sqrt(5.0)), tol = s_tolerance * (s_hi - s_lo);
+  double a = s_lo, b = s_hi, x = a + golden * (b - a), w = x, v = x, fx = f(x), fw = fx, fv = fx;
   double d = 0.0, e = 0.0;
   for (int it = 0; it < 100; ++it) {
     const double m = 0.5 * (a + b), tol1 = tol, tol2 = 2 * tol1;

@@ -97,6 +97,20 @@ struct Extremum {
 Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& options, const BranchPoint& from,
                         double step, const std::function<double(const Eigen::VectorXd&, double)>& g,
                         double s_tolerance = 1e-7);
+/// The same on [s_lo, s_hi] (0 <= s_lo < s_hi), s known to `s_tolerance` * (s_hi - s_lo);
+/// with `near` (a solution on the branch at arclength near.s, e.g. from sample_along) each
+/// corrector starts from it moved along the tangent rather than from the tangent line.
+Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& options, const BranchPoint& from,
+                        double s_lo, double s_hi, const std::function<double(const Eigen::VectorXd&, double)>& g,
+                        double s_tolerance = 1e-7, const Extremum* near = nullptr);
+
+/// g along the branch at the arclengths `s` (increasing) from point `from` along its tangent:
+/// the corrector's solution on each hyperplane t . (y - y_from) = s_j, started from the
+/// previous one moved by (s_j - s_{j-1}) t (cheap where the s_j are close). One entry per
+/// s_j; found = false where the corrector failed (and the next starts from the prediction).
+std::vector<Extremum> sample_along(ParametricResidual& residual, const ArclengthOptions& options,
+                                   const BranchPoint& from, const std::vector<double>& s,
+                                   const std::function<double(const Eigen::VectorXd&, double)>& g);
 
 /// Does point p lie on `branch` (traced with `options`)? The corrector from the branch point
 /// nearest to p (scaled distance), on the hyperplane through p normal to that point's tangent,

@@ -1,8 +1,11 @@
 #include "forced/frequency_response.hpp"
 
+#include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "continuation/events.hpp"
@@ -27,6 +30,118 @@ constexpr double kJoinTolerance = 1e-5;
 // tolerance near round-off.
 constexpr double kPolishAbove = 1e-6;
 constexpr double kPolishTolerance = 1e-12;
+
+// The corrector's tolerance at the trial points of a peak search, relative to the sampled
+// peak's own largest unknown. Near a maximum A(s) = A* - c (s - s*)^2, amplitude noise e
+// moves the located s* by sqrt(e / c): at the tracing tolerance (1e-8 of the free motion,
+// which can be 100 times the friction-damped peak) that was 1e-5 of the frequency on the
+// coarse sector (docs/continuation.md). At 1e-12 it is below 1e-8.
+constexpr double kPeakTolerance = 1e-12;
+
+// The top of a resonance peak of a sampled friction law is rippled: each corner of the law
+// (a sample changing between stick, slip and separation) is a kink of the amplitude along the
+// branch, and near the top several kinks are local maxima of nearly the same height
+// (measured on the coarse sector at N = 512: five within 3e-6 of the amplitude and 5e-5 of the
+// frequency, kinks 3e-7 to 3e-6 of the frequency apart). Brent's method finds one of them,
+// which one depends on the path. The largest is found by sampling the top: where the smooth
+// envelope (a parabola through the three sampled points) is within kRippleBand of the located
+// maximum, at kTopSamples points, then Brent's method at the kTopCandidates largest sampled
+// local maxima. Where the samples show a ripple above half the band, the band is widened to
+// twice it, once.
+constexpr double kRippleBand = 1e-5;  // relative to the peak amplitude
+constexpr int kTopSamples = 100;
+constexpr int kTopCandidates = 3;
+
+using Amplitude = std::function<double(const Eigen::VectorXd&, double)>;
+
+// Keeps the larger of best and e.
+void keep_larger(continuation::Extremum& best, const continuation::Extremum& e) {
+  if (e.found && (!best.found || e.value > best.value)) best = e;
+}
+
+// The largest maximum of the amplitude on the top of the peak whose two steps start at
+// points `left` (to `mid`) and `mid` (to `right`), with `best` Brent's maximum on them and
+// `lengths` the two steps' arclengths (<= 0: no step). Returns the larger of `best` and
+// what the samples find; adds the residual evaluations to `evaluations`.
+continuation::Extremum search_rippled_top(ReducedEquations& equations, const continuation::ArclengthOptions& fine,
+                                          const std::array<const continuation::BranchPoint*, 3>& pts,
+                                          const std::array<double, 3>& amp, const std::array<double, 2>& lengths,
+                                          continuation::Extremum best, const Amplitude& amplitude, int& evaluations) {
+  // The envelope A(l) = c0 + c1 l + c2 l^2 through the three sampled points (l: frequency).
+  const double l0 = pts[0]->lambda, l1 = pts[1]->lambda, l2 = pts[2]->lambda;
+  if (!(l0 < l1 && l1 < l2) && !(l0 > l1 && l1 > l2)) return best;  // a fold beside the top
+  const double d01 = (amp[1] - amp[0]) / (l1 - l0), d12 = (amp[2] - amp[1]) / (l2 - l1);
+  const double c2 = (d12 - d01) / (l2 - l0);
+  if (!(c2 < 0) || !best.found) return best;
+  double band = kRippleBand;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double half_width = std::sqrt(band * best.value / -c2);
+    const double lo = best.lambda - half_width, hi = best.lambda + half_width;
+    const double spacing = (hi - lo) / kTopSamples;
+    struct Sample {
+      continuation::Extremum e;
+      int step;
+    };
+    std::vector<Sample> samples;
+    std::vector<double> s_of_step[2];
+    for (int k = 0; k < 2; ++k) {
+      if (!(lengths[k] > 0)) continue;
+      // s along step k, linear in frequency between its ends.
+      const double la = pts[k]->lambda, lb = pts[k + 1]->lambda;
+      const double s_lo = std::clamp(lengths[k] * (std::min(lo, hi) - la) / (lb - la), 0.0, lengths[k]);
+      const double s_hi = std::clamp(lengths[k] * (std::max(lo, hi) - la) / (lb - la), 0.0, lengths[k]);
+      const double a = std::min(s_lo, s_hi), b = std::max(s_lo, s_hi);
+      const int n = static_cast<int>(std::ceil((b - a) / (lengths[k] * spacing / std::abs(lb - la))));
+      if (n < 1) continue;
+      std::vector<double> s;
+      for (int j = 0; j <= n; ++j) s.push_back(a + (b - a) * j / n);
+      for (continuation::Extremum& e : continuation::sample_along(equations, fine, *pts[k], s, amplitude)) {
+        evaluations += e.evaluations;
+        samples.push_back({std::move(e), k});
+      }
+    }
+    // The ripple: the largest departure of the samples from their own least-squares parabola.
+    Eigen::MatrixXd v(0, 3);
+    Eigen::VectorXd rhs(0);
+    {
+      std::vector<std::array<double, 2>> la;
+      for (const Sample& q : samples)
+        if (q.e.found) la.push_back({(q.e.lambda - best.lambda) / (hi - lo), q.e.value});
+      v.resize(static_cast<Eigen::Index>(la.size()), 3);
+      rhs.resize(v.rows());
+      for (Eigen::Index r = 0; r < v.rows(); ++r) {
+        const double t = la[static_cast<std::size_t>(r)][0];
+        v.row(r) << 1.0, t, t * t;
+        rhs[r] = la[static_cast<std::size_t>(r)][1];
+      }
+    }
+    // Brent's method at the largest sampled local maxima (neighbours on the same step).
+    std::vector<std::size_t> candidates;
+    for (std::size_t j = 1; j + 1 < samples.size(); ++j) {
+      const Sample &p = samples[j - 1], &q = samples[j], &r = samples[j + 1];
+      if (p.step != q.step || r.step != q.step || !p.e.found || !q.e.found || !r.e.found) continue;
+      if (q.e.value >= p.e.value && q.e.value >= r.e.value) candidates.push_back(j);
+    }
+    std::sort(candidates.begin(), candidates.end(),
+              [&](std::size_t a, std::size_t b) { return samples[a].e.value > samples[b].e.value; });
+    if (candidates.size() > static_cast<std::size_t>(kTopCandidates)) candidates.resize(kTopCandidates);
+    for (std::size_t j : candidates) {
+      keep_larger(best, samples[j].e);
+      const int k = samples[j].step;
+      const continuation::Extremum e = continuation::locate_maximum(equations, fine, *pts[k], samples[j - 1].e.s,
+                                                                    samples[j + 1].e.s, amplitude, 1e-7, &samples[j].e);
+      evaluations += e.evaluations;
+      keep_larger(best, e);
+    }
+    if (v.rows() < 4) break;
+    const Eigen::VectorXd coef = v.colPivHouseholderQr().solve(rhs);
+    const double ripple = (v * coef - rhs).lpNorm<Eigen::Infinity>() / best.value;
+    if (!(2 * ripple > band)) break;
+    band = 2 * ripple;
+  }
+  return best;
+}
+
 void say(const Info& info, const std::string& s) {
   if (info) info(s);
 }
@@ -518,22 +633,44 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
       if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
         int evaluations = 0;
         continuation::ScaledSystem sys(equations, ao, &evaluations);
-        auto amplitude = [&](const Eigen::VectorXd& x, double lambda) {
+        continuation::ArclengthOptions fine = ao;
+        const double own = out.points[i].x.lpNorm<Eigen::Infinity>();
+        const double unit = ao.x_scale.size() > 0 ? ao.x_scale.maxCoeff() : 1.0;
+        if (own > 0 && unit > 0) fine.tolerance = std::min(ao.tolerance, kPeakTolerance * own / unit);
+        const Amplitude amplitude = [&](const Eigen::VectorXd& x, double lambda) {
           return equations.analyse(x, lambda).amplitude;
         };
         // On the two steps beside the sampled maximum, each parametrized by the arclength
         // along the tangent of its first point.
-        for (std::size_t from : {idx[m - 1], i}) {
-          const std::size_t to = from == i ? idx[m + 1] : i;
-          const continuation::BranchPoint& p = out.points[from];
-          const double length =
-              p.tangent.dot(sys.to_scaled(out.points[to].x, out.points[to].lambda) - sys.to_scaled(p.x, p.lambda));
-          if (!(length > 0)) continue;
-          const continuation::Extremum e = continuation::locate_maximum(equations, ao, p, length, amplitude);
-          out.summary.residual_evaluations += e.evaluations;
-          if (!e.found) continue;
+        const std::array<const continuation::BranchPoint*, 3> pts = {&out.points[idx[m - 1]], &out.points[i],
+                                                                     &out.points[idx[m + 1]]};
+        std::array<double, 2> lengths{0.0, 0.0};
+        continuation::Extremum best;
+        int found_evaluations = 0;
+        for (int k = 0; k < 2; ++k) {
+          const continuation::BranchPoint& p = *pts[k];
+          const continuation::BranchPoint& q = *pts[k + 1];
+          lengths[k] = p.tangent.dot(sys.to_scaled(q.x, q.lambda) - sys.to_scaled(p.x, p.lambda));
+          if (!(lengths[k] > 0)) continue;
+          // At the tight tolerance; where the corrector cannot reach it, at the tracing one.
+          continuation::Extremum e = continuation::locate_maximum(equations, fine, p, lengths[k], amplitude);
+          found_evaluations += e.evaluations;
+          if (!e.found) {
+            e = continuation::locate_maximum(equations, ao, p, lengths[k], amplitude);
+            found_evaluations += e.evaluations;
+          }
+          keep_larger(best, e);
+        }
+        if (best.found)
+          best = search_rippled_top(
+              equations, fine, pts,
+              {out.results[idx[m - 1]].amplitude, out.results[i].amplitude, out.results[idx[m + 1]].amplitude}, lengths,
+              best, amplitude, found_evaluations);
+        out.summary.residual_evaluations += found_evaluations;
+        if (best.found) {
           peak.located = true;  // if no trial point beats the sampled one, it is the maximum to tolerance
-          if (e.value > peak.amplitude_m) peak.amplitude_m = e.value, peak.frequency_hz = e.lambda, peak.x = e.x;
+          if (best.value > peak.amplitude_m)
+            peak.amplitude_m = best.value, peak.frequency_hz = best.lambda, peak.x = best.x;
         }
       }
       out.peaks.push_back(peak);

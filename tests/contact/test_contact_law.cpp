@@ -65,6 +65,31 @@ TEST(ExactLinearStep, JacobianMatchesCentralDifferences) {
   EXPECT_GE(good, 0.97 * kStates);
 }
 
+// Without tangential motion the step sticks, and its derivative in dw is the identity (the
+// stuck stiffness); it used to be zero, the slipping derivative, with the stuck flag unset.
+TEST(ExactLinearStep, WithoutMotionItSticksWithTheStuckDerivative) {
+  constexpr double kH = 1e-7, kTol = 1e-8;
+  const Eigen::Vector2d e0(0.3, -0.2), dw = Eigen::Vector2d::Zero();
+  for (double a1 : {0.5, 1.0}) {  // the radius shrinks or grows, staying above |e0|
+    Eigen::Matrix<double, 2, 6> jac, fd;
+    bool stuck = false;
+    const Eigen::Vector2d e1 = shroudsim::contact::exact_linear_step(e0, dw, 0.8, a1, &jac, &stuck);
+    EXPECT_TRUE(stuck);
+    EXPECT_EQ(e1, e0);
+    for (int c = 0; c < 6; ++c) {
+      auto eval = [&](double step) {
+        Eigen::Vector2d e = e0, d = dw;
+        double b0 = 0.8, b1 = a1;
+        (c < 2 ? e[c] : c < 4 ? d[c - 2] : c == 4 ? b0 : b1) += step;
+        return shroudsim::contact::exact_linear_step(e, d, b0, b1);
+      };
+      fd.col(c) = (eval(kH) - eval(-kH)) / (2.0 * kH);
+    }
+    EXPECT_LE((jac - fd).norm(), kTol) << "a1 = " << a1 << "\n" << jac << "\n" << fd;
+    EXPECT_LE((jac.middleCols<2>(2) - Eigen::Matrix2d::Identity()).norm(), kRoundOff);
+  }
+}
+
 // Exact integration composes: one step over [0, 1] equals two half steps, the radius linear
 // throughout (mid radius (a0 + a1)/2), for stick, stick-then-slip and slip from the start.
 TEST(ExactLinearStep, TwoHalfStepsEqualOneStep) {

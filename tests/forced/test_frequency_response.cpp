@@ -78,6 +78,22 @@ Lumped mass_on_full3d(double s) {
   return l;
 }
 
+/// Three masses in a chain, each on a full3d contact (three_contacts.hpp), H = 3,
+/// N = 64, 6 to 12 Hz.
+Lumped three_contacts(int threads) {
+  Lumped l;
+  l.model.linear = std::make_unique<frf::LumpedLinearPart>(testing::three_contacts_linear());
+  l.model.pairs = testing::three_contacts_pairs();
+  l.options.n_harmonics = 3;
+  l.options.n_time_samples = 64;
+  l.options.law.model = contact::Model::full3d;
+  l.options.threads = threads;
+  l.options.measure_plans = false;
+  l.f_start = 6.0;
+  l.f_end = 12.0;
+  return l;
+}
+
 FrequencyResponse trace(Lumped& l, double initial_step_hz = 0.0) {
   hbm::ContactEvaluator ev(l.options, l.model.pairs);
   ReducedEquations eq(*l.model.linear, ev);
@@ -158,28 +174,53 @@ TEST(FrequencyResponse, PeakLocationDoesNotDependOnTheStep) {
   }
 }
 
+TEST(FrequencyResponse, TheLocatedPeakIsTheHighestOfADenseScanAtFixedFrequencies) {
+  // Three masses on full3d contacts: the located largest peak against Newton at fixed
+  // frequency on kScan + 1 frequencies across 0.2 % of it (each started from the last), solved
+  // to 1e-12 of the peak's motion. No scanned amplitude may exceed the located one beyond that
+  // tolerance, and the highest scanned one lies within a scan spacing of it.
+  Lumped l = three_contacts(1);
+  hbm::ContactEvaluator ev(l.options, l.model.pairs);
+  ReducedEquations eq(*l.model.linear, ev);
+  FrequencyResponseSettings s;
+  s.frequency_start_hz = l.f_start;
+  s.frequency_end_hz = l.f_end;
+  const FrequencyResponse r = trace_frequency_response(s, l.model, l.options, eq);
+  ASSERT_EQ(r.summary.status, continuation::BranchStatus::kReachedEnd) << r.summary.message;
+  const ResponsePeak& pk = largest(r);
+  ASSERT_TRUE(pk.located);
+  constexpr double kScanTol = 1e-12;
+  continuation::ArclengthOptions o = r.options;
+  o.tolerance = kScanTol * pk.x.lpNorm<Eigen::Infinity>() / o.x_scale.maxCoeff();
+  constexpr int kScan = 1001;  // odd: the located frequency itself is not on the grid
+  const double width = 2e-3 * pk.frequency_hz;
+  Eigen::VectorXd x = pk.x;
+  double best = 0, best_f = 0;
+  for (int j = 0; j <= kScan; ++j) {
+    const double f = pk.frequency_hz - width / 2 + width * j / kScan;
+    ASSERT_GE(continuation::newton_fixed(eq, x, f, o), 0) << f;
+    const double a = eq.analyse(x, f).amplitude;
+    if (a > best) best = a, best_f = f;
+  }
+  EXPECT_LE(best, pk.amplitude_m * (1 + 1e3 * kScanTol));  // amplitude error of the scan's solutions
+  EXPECT_NEAR(best_f, pk.frequency_hz, width / kScan);
+}
+
 TEST(FrequencyResponse, TheSameCurveBitForBitWhateverTheThreadCount) {
   // Three masses in a chain, each on a full3d contact; the GMRES path of the bordered solves
   // (forced) as well as the dense one.
   for (auto kind : {LinearSolverOptions::Kind::dense, LinearSolverOptions::Kind::krylov}) {
     std::vector<FrequencyResponse> r;
     for (int threads : {1, 2}) {
-      Lumped l;
-      l.model.linear = std::make_unique<frf::LumpedLinearPart>(testing::three_contacts_linear());
-      l.model.pairs = testing::three_contacts_pairs();
-      l.options.n_harmonics = 3;
-      l.options.n_time_samples = 64;
-      l.options.law.model = contact::Model::full3d;
-      l.options.threads = threads;
-      l.options.measure_plans = false;
+      Lumped l = three_contacts(threads);
       hbm::ContactEvaluator ev(l.options, l.model.pairs);
       ReducedEquations eq(*l.model.linear, ev);
       LinearSolverOptions so;
       so.kind = kind;
       eq.set_linear_solver(so);
       FrequencyResponseSettings s;
-      s.frequency_start_hz = 6.0;
-      s.frequency_end_hz = 12.0;
+      s.frequency_start_hz = l.f_start;
+      s.frequency_end_hz = l.f_end;
       r.push_back(trace_frequency_response(s, l.model, l.options, eq));
     }
     ASSERT_EQ(r[0].points.size(), r[1].points.size());

@@ -103,6 +103,34 @@ INSTANTIATE_TEST_SUITE_P(Models, JacobianVsFd,
                                            std::tuple{Model::full3d, TangentialUpdate::radial_return, 5, 128},
                                            std::tuple{Model::one_d_exact, TangentialUpdate::exact_linear, 1, 64}));
 
+// A pressed pair that does not move tangentially (a static state: every harmonic above 0 zero)
+// sticks at every sample, so any small tangential motion is resisted by kt: the analytic
+// Jacobian must be that stuck stiffness, as central differences say. (The coupled
+// exact_linear step once returned its slipping derivative where a sample had no tangential
+// motion: about 1e-11 of kt instead of kt.)
+TEST(ContactEvaluator, APairAtRestHasTheStuckStiffness) {
+  const shroudsim::contact::PairParameters p = test_pair();
+  for (auto [model, update] : {std::pair{Model::full3d, TangentialUpdate::exact_linear},
+                               std::pair{Model::full3d, TangentialUpdate::radial_return},
+                               std::pair{Model::quasi3d, TangentialUpdate::exact_linear}}) {
+    shroudsim::hbm::ContactEvaluatorOptions o = evaluator_options(3, 64);
+    o.law.model = model;
+    o.law.update = update;
+    ContactEvaluator ev(o, {p});
+    const Eigen::VectorXd w = Eigen::VectorXd::Zero(ev.size());  // pressed by the preload alone
+    Eigen::VectorXd fa, ff;
+    std::vector<Eigen::MatrixXd> ja, jf;
+    ev.evaluate(w, fa, &ja, JacobianMethod::analytic);
+    ev.evaluate(w, ff, &jf, JacobianMethod::finite_difference);
+    ASSERT_TRUE(ja[0].allFinite());
+    // Stuck throughout: the forces are linear in the motion here, so the difference is exact
+    // to round-off of kt.
+    EXPECT_LE(shroudsim::testing::relative_error(ja[0], jf[0]), kMedianTol)
+        << "model " << static_cast<int>(model) << ", update " << static_cast<int>(update);
+    EXPECT_GT(jf[0].cwiseAbs().maxCoeff(), 0.5 * p.tangential_stiffness);
+  }
+}
+
 // Block diagonal and parallel: evaluating pairs together, threaded, equals one at a time.
 TEST(ContactEvaluator, PairsAreIndependentAndThreadingChangesNothing) {
   shroudsim::contact::PairParameters p;
