@@ -32,11 +32,13 @@ constexpr double kPolishAbove = 1e-6;
 constexpr double kPolishTolerance = 1e-12;
 
 // The corrector's tolerance at the trial points of a peak search, relative to the sampled
-// peak's own largest unknown. Near a maximum A(s) = A* - c (s - s*)^2, amplitude noise e
-// moves the located s* by sqrt(e / c): at the tracing tolerance (1e-8 of the free motion,
-// which can be 100 times the friction-damped peak) that was 1e-5 of the frequency on the
-// coarse sector (docs/continuation.md). At 1e-12 it is below 1e-8.
-constexpr double kPeakTolerance = 1e-12;
+// peak's own largest unknown (never looser than the tracing tolerance). Near a maximum
+// A(s) = A* - c (s - s*)^2, amplitude noise e moves the located s* by sqrt(e / c): at the
+// tracing tolerance (1e-8 of the free motion, which can be 100 times the friction-damped
+// peak) that reached 1e-5 of the frequency. 1e-10 keeps it near 1e-7 on the coarse sector
+// (docs/continuation.md); 1e-12 costs the default wheel's peak 6 times the evaluations
+// (Newton stalls near round-off) for a change of 2e-8 in its frequency.
+constexpr double kPeakTolerance = 1e-10;
 
 // The top of a resonance peak of a sampled friction law is rippled: each corner of the law
 // (a sample changing between stick, slip and separation) is a kink of the amplitude along the
