@@ -425,14 +425,35 @@ std::vector<std::size_t> prominent_maxima(const std::vector<double>& a, double m
   return out;
 }
 
-FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& settings, const ForcedModel& model,
-                                           const hbm::ContactEvaluatorOptions& eo, ReducedEquations& equations,
-                                           const std::function<void(const continuation::BranchPoint&, int)>& progress,
-                                           const Info& info) {
+namespace {
+
+FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const ForcedModel& model,
+                             const hbm::ContactEvaluatorOptions& eo, ReducedEquations& equations,
+                             const std::function<void(const continuation::BranchPoint&, int)>& progress,
+                             const Info& info, bool may_reverse) {
   FrequencyResponse out;
   const continuation::ArclengthOptions ao = arclength_options(settings, model, equations);
   out.options = ao;
-  const Eigen::VectorXd start = find_start_logged(model, eo, equations, ao, ao.lambda_start, out.start, info);
+  Eigen::VectorXd start;
+  try {
+    start = find_start_logged(model, eo, equations, ao, ao.lambda_start, out.start, info);
+  } catch (const NumericalError& e) {
+    // No start at the start of the range: the whole range traced from its other end (the
+    // same curve, travelled the other way); if that has no start either, both reasons.
+    if (!may_reverse) throw;
+    say(info, "frf: no start at " + shortest(ao.lambda_start) + " Hz (" + e.what() + "); tracing from " +
+                  shortest(ao.lambda_end) + " Hz instead");
+    FrequencyResponseSettings reversed = settings;
+    std::swap(reversed.frequency_start_hz, reversed.frequency_end_hz);
+    try {
+      FrequencyResponse r = trace_from(reversed, model, eo, equations, progress, info, false);
+      r.start = "from the end of the range, " + r.start + " (none at " + shortest(ao.lambda_start) + " Hz)";
+      return r;
+    } catch (const NumericalError& e2) {
+      throw NumericalError(std::string(e.what()) + "; from the end of the range, " + shortest(ao.lambda_end) +
+                           " Hz, none either: " + e2.what());
+    }
+  }
   continuation::Branch first = continuation::trace(equations, start, ao, [&](const continuation::BranchPoint& p) {
     if (progress) progress(p, 0);
   });
@@ -681,6 +702,15 @@ FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& sett
   out.peaks = distinct_peaks(std::move(out.peaks), ao.lambda_scale);
   out.peak_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
+}
+
+}  // namespace
+
+FrequencyResponse trace_frequency_response(const FrequencyResponseSettings& settings, const ForcedModel& model,
+                                           const hbm::ContactEvaluatorOptions& eo, ReducedEquations& equations,
+                                           const std::function<void(const continuation::BranchPoint&, int)>& progress,
+                                           const Info& info) {
+  return trace_from(settings, model, eo, equations, progress, info, true);
 }
 
 std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double frequency_unit_hz) {

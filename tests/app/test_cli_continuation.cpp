@@ -130,8 +130,9 @@ TEST(CliContinuation, WhereNoMotionOfTheExcitationsPeriodExistsTheStopSaysSo) {
   // contact without preload, so it impacts; first mode 8.41 Hz) started at 4.27 Hz, about half
   // of it. No harmonic-balance start is found there, and a time integration from rest
   // (forced/time_march.hpp) settles on a motion that repeats every two excitation periods: a
-  // subharmonic, which a harmonic balance of the excitation's period cannot represent. The run
-  // stops (exit 3) and says so.
+  // subharmonic, which a harmonic balance of the excitation's period cannot represent. The range
+  // is traced from its other end, 12.3 Hz, until the branch turns back; then the run stops
+  // (exit 3) and says why there is no start at 4.27 Hz.
   const Scratch s("subharmonic");
   s.write("case.toml", R"(name = "stress_0131"
 
@@ -176,6 +177,11 @@ frequency_end_hz = 12.316202486923972
   EXPECT_NE(r.err.find("subharmonic (repeats every 2 excitation periods"), std::string::npos) << r.err;
   const auto run = nlohmann::json::parse(slurp(s.dir() / "out" / "run.json"));
   EXPECT_NE(run.dump().find("subharmonic"), std::string::npos);
+  // Without a start at the start of the range, the range was traced from its other end: the
+  // curve down to where the branch turns back is written (970 points).
+  EXPECT_NE(run["frf"]["start"].get<std::string>().find("from the end of the range"), std::string::npos)
+      << run["frf"]["start"];
+  EXPECT_GT(run["frf"]["points"].get<int>(), 100);
 }
 
 TEST(CliContinuation, WithoutAResonanceInTheRangeThePeakIsTheLargestPoint) {
