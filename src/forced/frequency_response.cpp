@@ -61,10 +61,10 @@ void keep_larger(continuation::Extremum& best, const continuation::Extremum& e) 
   if (e.found && (!best.found || e.value > best.value)) best = e;
 }
 
-// The largest maximum of the amplitude on the top of the peak whose two steps start at
-// points `left` (to `mid`) and `mid` (to `right`), with `best` Brent's maximum on them and
-// `lengths` the two steps' arclengths (<= 0: no step). Returns the larger of `best` and
-// what the samples find; adds the residual evaluations to `evaluations`.
+// The largest maximum of the amplitude on the top of the peak whose two steps run from
+// pts[0] to pts[1] and from pts[1] to pts[2] (amplitudes `amp`), with `best` Brent's maximum
+// on them and `lengths` the two steps' arclengths (<= 0: no step). Returns the larger of
+// `best` and what the samples find; adds the residual evaluations to `evaluations`.
 continuation::Extremum search_rippled_top(ReducedEquations& equations, const continuation::ArclengthOptions& fine,
                                           const std::array<const continuation::BranchPoint*, 3>& pts,
                                           const std::array<double, 3>& amp, const std::array<double, 2>& lengths,
@@ -85,14 +85,13 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
       int step;
     };
     std::vector<Sample> samples;
-    std::vector<double> s_of_step[2];
     for (int k = 0; k < 2; ++k) {
       if (!(lengths[k] > 0)) continue;
-      // s along step k, linear in frequency between its ends.
+      // s along step k, linear in frequency between its ends (which may run downwards).
       const double la = pts[k]->lambda, lb = pts[k + 1]->lambda;
-      const double s_lo = std::clamp(lengths[k] * (std::min(lo, hi) - la) / (lb - la), 0.0, lengths[k]);
-      const double s_hi = std::clamp(lengths[k] * (std::max(lo, hi) - la) / (lb - la), 0.0, lengths[k]);
-      const double a = std::min(s_lo, s_hi), b = std::max(s_lo, s_hi);
+      const double s_at_lo = std::clamp(lengths[k] * (lo - la) / (lb - la), 0.0, lengths[k]);
+      const double s_at_hi = std::clamp(lengths[k] * (hi - la) / (lb - la), 0.0, lengths[k]);
+      const double a = std::min(s_at_lo, s_at_hi), b = std::max(s_at_lo, s_at_hi);
       const int n = static_cast<int>(std::ceil((b - a) / (lengths[k] * spacing / std::abs(lb - la))));
       if (n < 1) continue;
       std::vector<double> s;
@@ -102,20 +101,17 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
         samples.push_back({std::move(e), k});
       }
     }
-    // The ripple: the largest departure of the samples from their own least-squares parabola.
-    Eigen::MatrixXd v(0, 3);
-    Eigen::VectorXd rhs(0);
-    {
-      std::vector<std::array<double, 2>> la;
-      for (const Sample& q : samples)
-        if (q.e.found) la.push_back({(q.e.lambda - best.lambda) / (hi - lo), q.e.value});
-      v.resize(static_cast<Eigen::Index>(la.size()), 3);
-      rhs.resize(v.rows());
-      for (Eigen::Index r = 0; r < v.rows(); ++r) {
-        const double t = la[static_cast<std::size_t>(r)][0];
-        v.row(r) << 1.0, t, t * t;
-        rhs[r] = la[static_cast<std::size_t>(r)][1];
-      }
+    // The ripple: the largest departure of the found samples from their own least-squares
+    // parabola in the frequency (centred and scaled to the band).
+    const auto n_found = std::count_if(samples.begin(), samples.end(), [](const Sample& q) { return q.e.found; });
+    Eigen::MatrixXd v(n_found, 3);
+    Eigen::VectorXd rhs(n_found);
+    Eigen::Index row = 0;
+    for (const Sample& q : samples) {
+      if (!q.e.found) continue;
+      const double t = (q.e.lambda - best.lambda) / (hi - lo);
+      v.row(row) << 1.0, t, t * t;
+      rhs[row++] = q.e.value;
     }
     // Brent's method at the largest sampled local maxima (neighbours on the same step).
     std::vector<std::size_t> candidates;
