@@ -227,7 +227,8 @@ constexpr int kFinerTimeSamples = 1024;
 
 bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
                            ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
-                           Eigen::VectorXd& x, std::string& how, std::string& why, const Info& info) {
+                           Eigen::VectorXd& x, std::string& how, std::string& why, bool& not_periodic,
+                           const Info& info) {
   const auto* lumped = dynamic_cast<const frf::LumpedLinearPart*>(model.linear.get());
   if (lumped == nullptr) return false;
   const LumpedSystem system{lumped->mass(), lumped->damping(), lumped->stiffness(), lumped->contact_operator(),
@@ -244,6 +245,7 @@ bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluator
   const bool nearly = tm.motion == TimeMarchResult::Motion::not_settled && tm.change_one_period < kNearlyPeriodic;
   if (tm.motion != TimeMarchResult::Motion::periodic && !nearly) {
     why = what;
+    not_periodic = true;
     return false;
   }
   x = harmonic_unknowns(tm.contact_motion, eo.n_harmonics, contact::n_directions(eo.law.model));
@@ -317,8 +319,11 @@ Eigen::VectorXd find_start_logged(const ForcedModel& model, const hbm::ContactEv
     }
     Eigen::VectorXd x;
     std::string why;
-    if (start_from_time_march(model, eo, equations, ao, f, x, how, why, info)) return x;
-    if (!why.empty()) throw NumericalError(std::string(first.what()) + "; time integration: " + why);
+    bool not_periodic = false;
+    if (start_from_time_march(model, eo, equations, ao, f, x, how, why, not_periodic, info)) return x;
+    const std::string message = std::string(first.what()) + "; time integration: " + why;
+    if (not_periodic) throw NoPeriodicMotion(message);
+    if (!why.empty()) throw NumericalError(message);
     throw;
   }
 }
@@ -446,8 +451,11 @@ FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const Fo
       r.start = "from the end of the range, " + r.start + " (none at " + shortest(ao.lambda_start) + " Hz)";
       return r;
     } catch (const NumericalError& e2) {
-      throw NumericalError(std::string(e.what()) + "; from the end of the range, " + shortest(ao.lambda_end) +
-                           " Hz, none either: " + e2.what());
+      const std::string both = std::string(e.what()) + "; from the end of the range, " + shortest(ao.lambda_end) +
+                               " Hz, none either: " + e2.what();
+      if (dynamic_cast<const NoPeriodicMotion*>(&e) && dynamic_cast<const NoPeriodicMotion*>(&e2))
+        throw NoPeriodicMotion(both);
+      throw NumericalError(both);
     }
   }
   continuation::Branch first = continuation::trace(equations, start, ao, [&](const continuation::BranchPoint& p) {

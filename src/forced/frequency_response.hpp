@@ -23,6 +23,7 @@
 
 #include "contact/contact_law.hpp"
 #include "continuation/arclength.hpp"
+#include "core/error.hpp"
 #include "forced/reduced_equations.hpp"
 #include "frf/linear_part.hpp"
 #include "frf/sector.hpp"
@@ -113,9 +114,20 @@ struct FrequencyResponse {
   int polished_points = 0;    ///< points re-solved at their own scale for the energy balance
 };
 
+/// No start at either end of the range, and at each a time integration from rest (lumped
+/// models) settled to a motion that does not repeat every excitation period (subharmonic, or
+/// not periodic): the stable steady motion has no harmonic balance of the excitation's period
+/// to start from. (An unstable periodic solution may still exist and be reached by a branch
+/// from elsewhere; the start search alone cannot find it.)
+class NoPeriodicMotion : public NumericalError {
+ public:
+  using NumericalError::NumericalError;
+};
+
 /// The forced response over the range. progress is called for every point that stays on the
 /// curve (piece 0, then piece 1 once it is known to join). Throws NumericalError when no start
-/// is found; any other failure is in summary.status / summary.message with what was traced.
+/// is found (NoPeriodicMotion when time integration shows why); any other failure is in
+/// summary.status / summary.message with what was traced.
 FrequencyResponse trace_frequency_response(
     const FrequencyResponseSettings& settings, const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
     ReducedEquations& equations, const std::function<void(const continuation::BranchPoint&, int piece)>& progress = {},

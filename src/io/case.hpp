@@ -131,6 +131,7 @@ struct HbmSection {
   double auto_tolerance;      ///< "auto": relative change of the peak amplitude to stop at
   int auto_max_harmonics;     ///< "auto": largest H tried
   int auto_max_time_samples;  ///< "auto": largest N tried
+  bool raise_time_samples;    ///< a fixed N that stops is traced again with 4 N, 16 N (docs/continuation.md)
 };
 
 struct ContinuationSection {

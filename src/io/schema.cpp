@@ -684,6 +684,10 @@ Schema declare() {
   d.integer("hbm.auto_max_time_samples", at(&Case::hbm, &H::auto_max_time_samples), 4096, "",
             "\"auto\" time samples: largest N tried")
       .range(16, 65536);
+  d.boolean("hbm.raise_time_samples", at(&Case::hbm, &H::raise_time_samples), true,
+            "a fixed N whose forced response stops at a corner of the sampled law, finds no start or fails its energy "
+            "check is traced again with 4 N, then 16 N (up to hbm.auto_max_time_samples); run.json frf.time_samples "
+            "is the N of the result");
 
   d.section("continuation", "pseudo-arclength continuation over the excitation frequency");
   auto& start = d.number("continuation.frequency_start_hz",

@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "forced/discretization_search.hpp"
+#include "forced/frequency_response.hpp"
 #include "forced/reduced_equations.hpp"
 #include "forced/stability.hpp"
 #include "hbm/contact_evaluator.hpp"
@@ -254,6 +255,8 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   const continuation::Branch& branch = response.summary;
   const std::vector<forced::PointResult>& results = response.results;
   auto& j = ctx.report.section("frf");
+  j["harmonics"] = c.hbm.harmonics;  // of this curve (a search or a raised N may differ from the case's)
+  j["time_samples"] = c.hbm.time_samples;
   j["start"] = response.start;
   if (response.two_pieces) j["start_second_piece"] = response.start_second_piece;
   for (const auto& w : response.warnings) ctx.report.warn(w);
@@ -417,6 +420,104 @@ ForcedResponseOutcome search_discretization(Context& ctx) {
   return outcome;
 }
 
+/// Whether a fixed-N curve that failed (the report's "frf" section) may pass with a finer N:
+/// a corner of the sampled law the corrector could not get round, a branch that turned back
+/// or closed on itself (twins and loops of the sampled law a sample apart), an energy balance
+/// beyond its tolerance. Not a max_points stop (the user's budget of points).
+// A failure without its "(K points written to frf.csv)": said of a curve that a raised N replaced.
+std::string without_written_note(const std::string& failure) {
+  const std::size_t at = failure.rfind(" (");
+  const bool note = at != std::string::npos && failure.size() > at + 2 && failure.back() == ')' &&
+                    failure.find("written to frf.csv", at) != std::string::npos;
+  return note ? failure.substr(0, at) : failure;
+}
+
+bool finer_sampling_may_pass(const nlohmann::json& frf) {
+  const std::string status = frf.value("status", "");
+  if (status == "reached_end") return !frf.value("energy_check_passed", true);
+  return status == "step_too_small" || status == "left_range" || status == "closed_loop";
+}
+
+/// One fixed-N forced response; where it stops for a reason a finer sampling of the period
+/// can remove (finer_sampling_may_pass, or no start without time integration having shown
+/// that no periodic motion exists) and hbm.raise_time_samples is on, traced again with 4 N,
+/// then 16 N (at most hbm.auto_max_time_samples) into <out>/raised/N=../; the first that
+/// passes its checks is the result (its files copied to out, run.json frf.time_samples its N,
+/// frf.time_samples_raised every attempt, a warning). When none passes, the first attempt's
+/// files and failure stand, with what the others found appended (docs/continuation.md,
+/// "Raising N").
+ForcedResponseOutcome trace_raising_time_samples(Context& ctx) {
+  const io::Case& c = ctx.config;
+  const int n0 = c.hbm.time_samples;
+  ForcedResponseOutcome first;
+  bool thrown = false;
+  try {
+    first = trace_case(ctx);
+  } catch (const forced::NoPeriodicMotion&) {
+    throw;
+  } catch (const NumericalError& e) {
+    if (!c.hbm.raise_time_samples) throw;
+    first.failure = e.what();
+    thrown = true;
+  }
+  if (first.failure.empty() || !c.hbm.raise_time_samples) return first;
+  if (!thrown && !finer_sampling_may_pass(ctx.report.section("frf"))) return first;
+
+  log::Stopwatch clock;  // of the attempts with a raised N (the first is the "frf" stage)
+  nlohmann::json attempts = nlohmann::json::array();
+  attempts.push_back({{"time_samples", n0}, {"passed", false}, {"message", first.failure}});
+  std::string tried;
+  constexpr int kFactor = 4, kAttempts = 2;
+  int n = n0;
+  for (int a = 0; a < kAttempts; ++a) {
+    const int next = std::min(n * kFactor, c.hbm.auto_max_time_samples);
+    if (next <= n) break;
+    n = next;
+    log::info("frf: N = " + std::to_string(n0) + " failed (" + first.failure +
+              "); tracing again with N = " + std::to_string(n) + " (hbm.raise_time_samples)");
+    Context tc;
+    tc.config = c;
+    tc.config.hbm.time_samples = n;
+    tc.out_dir = ctx.out_dir / "raised" / ("N=" + std::to_string(n));
+    tc.threads = ctx.threads;
+    tc.overrides = ctx.overrides;
+    tc.plots = ctx.plots;
+    ForcedResponseOutcome o;
+    try {
+      o = trace_case(tc);
+    } catch (const NumericalError& e) {
+      o.failure = e.what();
+    }
+    attempts.push_back({{"time_samples", n}, {"passed", o.failure.empty()}, {"message", o.failure}});
+    if (!o.failure.empty()) {
+      tried += "; traced again with N = " + std::to_string(n) + ": " + o.failure;
+      continue;
+    }
+    // Passed: its files are the result (frames of the first attempt replaced, not mixed).
+    if (std::filesystem::exists(tc.out_dir / "frf_frames")) std::filesystem::remove_all(ctx.out_dir / "frf_frames");
+    std::filesystem::copy(tc.out_dir, ctx.out_dir,
+                          std::filesystem::copy_options::recursive | std::filesystem::copy_options::overwrite_existing);
+    std::filesystem::remove_all(ctx.out_dir / "raised");
+    nlohmann::json frf = tc.report.json().value("frf", nlohmann::json::object());
+    frf["time_samples_raised"] = {{"from", n0}, {"attempts", attempts}};
+    ctx.report.section("frf") = frf;
+    for (const auto& w : tc.report.json().value("warnings", nlohmann::json::array()))
+      ctx.report.section("warnings").push_back(w);
+    ctx.report.warn("hbm.time_samples = " + std::to_string(n0) + ": the forced response failed (" +
+                    without_written_note(first.failure) + "); traced again with N = " + std::to_string(n) +
+                    ", it passed its checks: the result is at N = " + std::to_string(n) +
+                    " (hbm.raise_time_samples = false keeps the case's N)");
+    ctx.frf_curve = std::move(tc.frf_curve);
+    ctx.report.stage("frf_raised_time_samples", clock.seconds());
+    return o;
+  }
+  ctx.report.stage("frf_raised_time_samples", clock.seconds());
+  if (thrown) throw NumericalError(first.failure + tried);
+  ctx.report.section("frf")["time_samples_raised"] = {{"from", n0}, {"attempts", attempts}};
+  first.failure += tried;
+  return first;
+}
+
 }  // namespace
 
 ForcedResponseOutcome run_forced_response(Context& ctx) {
@@ -426,7 +527,7 @@ ForcedResponseOutcome run_forced_response(Context& ctx) {
                      ": excitation.force is zero: the forced response is the trivial zero solution (nothing to trace)");
   }
   if (c.hbm.harmonics_auto || c.hbm.time_samples_auto) return search_discretization(ctx);
-  return trace_case(ctx);
+  return trace_raising_time_samples(ctx);
 }
 
 }  // namespace shroudsim::pipeline

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -125,6 +126,78 @@ TEST(CliContinuation, ACurveThatFailsItsEnergyCheckIsNotReportedAsSuccess) {
   EXPECT_EQ(good.status, 0) << good.err;
 }
 
+TEST(CliContinuation, ACurveThatStopsAtCornersOfTheSampledLawIsTracedAgainWithAFinerSampling) {
+  // Stress corpus model 14 (quasi3d, H = 2, N = 64): at N = 64 the branch closes on itself at
+  // a corner of the sampled law, from either end and from the middle of the gap (exit 3). With
+  // hbm.raise_time_samples (the default) it is traced again with 4 N = 256, which reaches the
+  // end: the result is that curve, exactly the one a case with N = 256 gives, and run.json and
+  // the warning say so. With the option off, the case's N stands and the stop is reported.
+  const Scratch s("raise_n");
+  s.write("case.toml", R"(name = "stress_0014"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[60.03472219001946, 0.0, 0.0, 0.0, 0.0], [0.0, 31.189723176261673, 0.0, 0.0, 0.0], [0.0, 0.0, 49.29516142930039, 0.0, 0.0], [0.0, 0.0, 0.0, 76.20675453473119, 0.0], [0.0, 0.0, 0.0, 0.0, 29.071178341147046]]
+stiffness = [[9368.054461067362, 2730.13310342276, 2196.5868893828997, 4677.736728095047, 3034.6263212322365], [2730.13310342276, 11636.947235488784, 2440.477623090116, 6158.901119219361, -2576.274558823115], [2196.5868893828997, 2440.477623090116, 8554.744069306267, -1087.0994399904132, -192.86160993255024], [4677.736728095047, 6158.901119219361, -1087.0994399904132, 14976.25210078617, 849.0895873679985], [3034.6263212322365, -2576.274558823115, -192.86160993255024, 849.0895873679985, 8892.469835005626]]
+damping = [[29.90879857627771, 3.982528367251045, 3.204228243352614, 6.823557133831758, 4.426701904446536], [3.982528367251045, 25.414036488147232, 3.559999089939157, 8.984176774251276, -3.758090218926391], [3.204228243352614, 3.559999089939157, 25.816641971258775, -1.5857850858468343, -0.2813331084653534], [6.823557133831758, 8.984176774251276, -1.5857850858468343, 42.46524340774627, 1.2385928597368139], [4.426701904446536, -3.758090218926391, -0.2813331084653534, 1.2385928597368139, 20.837378254336958]]
+
+[excitation]
+force = 16999.121192627077
+dof = 3
+
+[response]
+dof = 0
+
+[contact]
+model = "quasi3d"
+friction_coefficient = 0.3344267324403067
+tangential_stiffness = 656.0573797507546
+normal_stiffness = 6619457.879076438
+normal_preload = 14.308612615242884
+frame_angle_deg = 0.0
+
+[[contact.elements]]
+x_dof = 1
+y_dof = 0
+z_dof = 3
+
+[hbm]
+harmonics = 2
+time_samples = 64
+
+[continuation]
+frequency_start_hz = 0.9967331688984198
+frequency_end_hz = 2.1641631349525445)");
+  const CliResult raised = s.run("frf case.toml --quiet --out raised");
+  ASSERT_EQ(raised.status, 0) << raised.err;
+  const auto frf = frf_of(s, "raised");
+  EXPECT_EQ(frf["time_samples"].get<int>(), 256);
+  EXPECT_EQ(frf["status"], "reached_end");
+  ASSERT_TRUE(frf.contains("time_samples_raised"));
+  EXPECT_EQ(frf["time_samples_raised"]["from"].get<int>(), 64);
+  const auto& attempts = frf["time_samples_raised"]["attempts"];
+  ASSERT_EQ(attempts.size(), 2u);
+  EXPECT_FALSE(attempts[0]["passed"].get<bool>());
+  EXPECT_NE(attempts[0]["message"].get<std::string>().find("closed on itself"), std::string::npos);
+  EXPECT_TRUE(attempts[1]["passed"].get<bool>());
+  EXPECT_NE(raised.err.find("traced again with N = 256"), std::string::npos) << raised.err;
+  EXPECT_FALSE(std::filesystem::exists(s.dir() / "raised" / "raised")) << "the attempt's folder is removed";
+
+  const CliResult direct = s.run("frf case.toml --quiet --out direct --set hbm.time_samples=256");
+  ASSERT_EQ(direct.status, 0) << direct.err;
+  EXPECT_FALSE(frf_of(s, "direct").contains("time_samples_raised"));
+  EXPECT_EQ(slurp(s.dir() / "raised" / "frf.csv"), slurp(s.dir() / "direct" / "frf.csv"));
+  EXPECT_EQ(slurp(s.dir() / "raised" / "peaks.csv"), slurp(s.dir() / "direct" / "peaks.csv"));
+
+  const CliResult kept = s.run("frf case.toml --quiet --out kept --set hbm.raise_time_samples=false");
+  EXPECT_EQ(kept.status, 3) << kept.err;
+  EXPECT_NE(kept.err.find("closed on itself"), std::string::npos) << kept.err;
+  const auto k = frf_of(s, "kept");
+  EXPECT_EQ(k["time_samples"].get<int>(), 64);
+  EXPECT_FALSE(k.contains("time_samples_raised"));
+}
+
 TEST(CliContinuation, WhereNoMotionOfTheExcitationsPeriodExistsTheStopSaysSo) {
   // A stress-corpus model (tools/stress_continuation.py, seed 1, model 131: 3 DOFs, a full3d
   // contact without preload, so it impacts; first mode 8.41 Hz) started at 4.27 Hz, about half
@@ -132,7 +205,9 @@ TEST(CliContinuation, WhereNoMotionOfTheExcitationsPeriodExistsTheStopSaysSo) {
   // (forced/time_march.hpp) settles on a motion that repeats every two excitation periods: a
   // subharmonic, which a harmonic balance of the excitation's period cannot represent. The range
   // is traced from its other end, 12.3 Hz, until the branch turns back; then the run stops
-  // (exit 3) and says why there is no start at 4.27 Hz.
+  // (exit 3) and says why there is no start at 4.27 Hz. (With hbm.raise_time_samples on, the
+  // default, the range is then traced again with N = 512: from 12.3 Hz that branch reaches
+  // 4.27 Hz, 441 points, exit 0, in about a minute; this test keeps N = 128.)
   const Scratch s("subharmonic");
   s.write("case.toml", R"(name = "stress_0131"
 
@@ -171,7 +246,7 @@ time_samples = 128
 frequency_start_hz = 4.269022959253111
 frequency_end_hz = 12.316202486923972
 )");
-  const CliResult r = s.run("frf case.toml --quiet --out out");
+  const CliResult r = s.run("frf case.toml --quiet --out out --set hbm.raise_time_samples=false");
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("no solution at the start frequency"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("subharmonic (repeats every 2 excitation periods"), std::string::npos) << r.err;
