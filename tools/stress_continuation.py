@@ -44,7 +44,9 @@ How a model is drawn (every parameter is recorded in the CSV and the failure lin
   mode (20 %) or the first mode of the stuck system (25 %, pressed contacts only; else a
   random free mode), from 0.5..0.8 to 1.25..1.8 times the centre, swept downward in 10 %;
 - hbm.harmonics H uniform in 1..15, hbm.time_samples N = the smallest power of two
-  >= max(64, 4 (2H + 1)).
+  >= max(64, 4 (2H + 1)) (hbm.raise_time_samples stays at its default, on: a curve that
+  stops at the sampled law's corners is traced again with 4 N, 16 N; the summary counts
+  those, the CSV has the N of each result and raised_from).
 
 Exit classes: ok (0), bad_input (2: a generator bug), numerics (3), timeout, other (any
 other status or a signal). Case files stay in OUT/cases/, results of failing runs in
@@ -433,7 +435,7 @@ def describe(p):
 # Running.
 
 FRF_FIELDS = ["status", "message", "points", "pieces", "turning_points", "peak_amplitude_m",
-              "peak_frequency_hz", "max_energy_balance_error"]
+              "peak_frequency_hz", "max_energy_balance_error", "time_samples"]
 
 
 def run_case(p, binary, out, timeout, sets=()):
@@ -469,6 +471,8 @@ def run_case(p, binary, out, timeout, sets=()):
         pass
     for key in FRF_FIELDS:
         row[key] = frf.get(key)
+    # hbm.raise_time_samples: the case's N when a finer one replaced it (None otherwise).
+    row["raised_from"] = (frf.get("time_samples_raised") or {}).get("from") if row["exit"] == 0 else None
     # A run that stopped before the continuation (no start found) has no "frf" section:
     # run.json's own status and message say why.
     for key in ("status", "message"):
@@ -613,6 +617,12 @@ def main():
     print()
     print("Summary (seed %d):" % args.seed)
     print("  reached the end (exit 0): %d of %d (%d of them in two pieces)" % (count("ok"), len(rows), two_pieces))
+    raised = [r for r in ok_rows if r.get("raised_from")]
+    if raised:
+        factors = sorted(set(r["time_samples"] // r["raised_from"] for r in raised))
+        print("    of them traced again with a finer N (hbm.raise_time_samples): %d (%s)" % (
+            len(raised), ", ".join("%d N: %d" % (k, sum(1 for r in raised if r["time_samples"] // r["raised_from"] == k))
+                                   for k in factors)))
     print("  bad input (exit 2, generator bugs): %d" % count("bad_input"))
     print("  numerics failed (exit 3): %d" % count("numerics"))
     # The start search integrates a lumped model in time when the harmonic balance finds no
@@ -653,7 +663,7 @@ def main():
 
     if args.csv:
         keys = [k for k in models[0] if k != "toml"]
-        rkeys = ["exit", "exit_class", "seconds"] + FRF_FIELDS
+        rkeys = ["exit", "exit_class", "seconds"] + FRF_FIELDS + ["raised_from"]
         with open(args.csv, "w", newline="") as f:
             w = csv.writer(f)
             w.writerow(keys + rkeys + ["case_file"])
