@@ -315,6 +315,22 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   return outcome;
 }
 
+/// The context of one trial curve of ctx's case at a fixed H and N, into its own folder: the
+/// "auto" search's trials and the attempts with a raised N.
+Context trial_context(const Context& ctx, int h, int n, const std::filesystem::path& out_dir, bool plots) {
+  Context tc;
+  tc.config = ctx.config;
+  tc.config.hbm.harmonics = h;
+  tc.config.hbm.harmonics_auto = false;
+  tc.config.hbm.time_samples = n;
+  tc.config.hbm.time_samples_auto = false;
+  tc.out_dir = out_dir;
+  tc.threads = ctx.threads;
+  tc.overrides = ctx.overrides;
+  tc.plots = plots;
+  return tc;
+}
+
 /// hbm.harmonics and/or hbm.time_samples = "auto": the search of
 /// forced/discretization_search.hpp, each trial a full forced response into
 /// <out>/auto/H=..__N=../ compared in memory; the accepted trial's frf.csv, loops.csv and
@@ -327,16 +343,8 @@ ForcedResponseOutcome search_discretization(Context& ctx) {
   std::vector<std::filesystem::path> dirs;
   auto run_trial = [&](int h, int n) {
     forced::DiscretizationTrial t;
-    Context tc;
-    tc.config = c;
-    tc.config.hbm.harmonics = h;
-    tc.config.hbm.harmonics_auto = false;
-    tc.config.hbm.time_samples = n;
-    tc.config.hbm.time_samples_auto = false;
-    tc.out_dir = ctx.out_dir / "auto" / ("H=" + std::to_string(h) + "__N=" + std::to_string(n));
-    tc.threads = ctx.threads;
-    tc.overrides = ctx.overrides;
-    tc.plots = false;
+    Context tc =
+        trial_context(ctx, h, n, ctx.out_dir / "auto" / ("H=" + std::to_string(h) + "__N=" + std::to_string(n)), false);
     log::set_verbose(false);
     try {
       t.message = trace_case(tc).failure;
@@ -420,10 +428,6 @@ ForcedResponseOutcome search_discretization(Context& ctx) {
   return outcome;
 }
 
-/// Whether a fixed-N curve that failed (the report's "frf" section) may pass with a finer N:
-/// a corner of the sampled law the corrector could not get round, a branch that turned back
-/// or closed on itself (twins and loops of the sampled law a sample apart), an energy balance
-/// beyond its tolerance. Not a max_points stop (the user's budget of points).
 // A failure without its "(K points written to frf.csv)": said of a curve that a raised N replaced.
 std::string without_written_note(const std::string& failure) {
   const std::size_t at = failure.rfind(" (");
@@ -432,6 +436,10 @@ std::string without_written_note(const std::string& failure) {
   return note ? failure.substr(0, at) : failure;
 }
 
+/// Whether a fixed-N curve that failed (the report's "frf" section) may pass with a finer N:
+/// a corner of the sampled law the corrector could not get round, a branch that turned back
+/// or closed on itself (twins and loops of the sampled law a sample apart), an energy balance
+/// beyond its tolerance. Not a max_points stop (the user's budget of points).
 bool finer_sampling_may_pass(const nlohmann::json& frf) {
   const std::string status = frf.value("status", "");
   if (status == "reached_end") return !frf.value("energy_check_passed", true);
@@ -475,13 +483,7 @@ ForcedResponseOutcome trace_raising_time_samples(Context& ctx) {
     n = next;
     log::info("frf: N = " + std::to_string(n0) + " failed (" + first.failure +
               "); tracing again with N = " + std::to_string(n) + " (hbm.raise_time_samples)");
-    Context tc;
-    tc.config = c;
-    tc.config.hbm.time_samples = n;
-    tc.out_dir = ctx.out_dir / "raised" / ("N=" + std::to_string(n));
-    tc.threads = ctx.threads;
-    tc.overrides = ctx.overrides;
-    tc.plots = ctx.plots;
+    Context tc = trial_context(ctx, c.hbm.harmonics, n, ctx.out_dir / "raised" / ("N=" + std::to_string(n)), ctx.plots);
     ForcedResponseOutcome o;
     try {
       o = trace_case(tc);
