@@ -212,15 +212,22 @@ Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& op
   const Eigen::VectorXd y0 = sys.to_scaled(from.x, from.lambda);
   const Eigen::VectorXd& t0 = from.tangent;
   // -g at arclength s (infinity where the corrector fails).
-  const Eigen::VectorXd y_near = near && near->found ? sys.to_scaled(near->x, near->lambda) : Eigen::VectorXd();
+  // Each trial starts from the best trial so far (Brent's trials close in on it; before the
+  // first, from `near` or the tangent line), moved along the tangent: far fewer corrector
+  // iterations than from the tangent line.
+  Eigen::VectorXd y_near = near && near->found ? sys.to_scaled(near->x, near->lambda) : Eigen::VectorXd();
+  double s_near = near && near->found ? near->s : 0.0;
   auto f = [&](double s) {
     const Eigen::VectorXd y_pred = y0 + s * t0;
-    Eigen::VectorXd y = y_near.size() ? Eigen::VectorXd(y_near + (s - near->s) * t0) : y_pred;
+    Eigen::VectorXd y = y_near.size() ? Eigen::VectorXd(y_near + (s - s_near) * t0) : y_pred;
     double rnorm = 0.0;
     if (correct(sys, y, t0, y_pred, rnorm) < 0) return std::numeric_limits<double>::infinity();
     const Eigen::VectorXd x = sys.x_of(y);
     const double lambda = sys.lambda_of(y), v = g(x, lambda);
-    if (!best.found || v > best.value) best = Extremum{true, s, x, lambda, v, 0};
+    if (!best.found || v > best.value) {
+      best = Extremum{true, s, x, lambda, v, 0};
+      y_near = y, s_near = s;
+    }
     return -v;
   };
   // Brent's minimization of f on [s_lo, s_hi] (golden section with parabolic steps).

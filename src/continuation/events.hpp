@@ -85,7 +85,8 @@ class ReflectionWatch {
 /// The maximum of g(x, lambda) along the branch between point `from` and the point at
 /// arclength `step` along its tangent (`options` as the branch was traced with): Brent's
 /// method on the arclength s in [0, step], each g evaluated at the corrector's solution on the
-/// hyperplane t . (y - y_from) = s. Stops when s is known to `s_tolerance` * step.
+/// hyperplane t . (y - y_from) = s, started from the best trial so far moved along the
+/// tangent (the first from the tangent line). Stops when s is known to `s_tolerance` * step.
 struct Extremum {
   bool found = false;
   double s = 0.0;
@@ -98,8 +99,8 @@ Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& op
                         double step, const std::function<double(const Eigen::VectorXd&, double)>& g,
                         double s_tolerance = 1e-7);
 /// The same on [s_lo, s_hi] (0 <= s_lo < s_hi), s known to `s_tolerance` * (s_hi - s_lo);
-/// with `near` (a solution on the branch at arclength near.s, e.g. from sample_along) each
-/// corrector starts from it moved along the tangent rather than from the tangent line.
+/// with `near` (a solution on the branch at arclength near.s, e.g. from sample_along) the
+/// first trial starts from it moved along the tangent rather than from the tangent line.
 Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& options, const BranchPoint& from,
                         double s_lo, double s_hi, const std::function<double(const Eigen::VectorXd&, double)>& g,
                         double s_tolerance = 1e-7, const Extremum* near = nullptr);

@@ -1,10 +1,16 @@
 #include "forced/excitation_homotopy.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace shroudsim::forced {
 
 namespace {
+
+// The homotopy path's extent in x, in units: the path runs from the preload-only state to
+// a motion between the stuck and the free one, and its arclength is a 2-norm over every
+// unknown, so the unit is a fraction of the larger of those motions' 2-norms.
+constexpr double kPathUnits = 2.0;
 
 /// r(W, s) = W - s W_lin + G F(W) at a fixed frequency: lambda is the excitation scale.
 class ExcitationHomotopy : public continuation::ParametricResidual {
@@ -57,8 +63,16 @@ continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, d
   o.max_step = 4.0;
   o.max_points = std::min(o.max_points, 2000);  // a start that needs more is not worth waiting for
   o.start_slack = target;                       // the path may fold back through s < 0 (the excitation reversed)
+  // The path's own unit (kPathUnits). The caller's (a twentieth of the free peak over the
+  // whole range, per unknown) can be orders of magnitude off it: at 92 Hz, below a lightly
+  // damped resonance, on a sector with 89 shroud pairs (2,937 unknowns) the path was hundreds
+  // of units long and took 1,785 steps; with its own unit, 83 (docs/continuation.md, "Start").
+  equations.set_excitation_scale(target);
+  const Eigen::VectorXd stuck_end = equations.stuck_solution(frequency_hz);
   equations.set_excitation_scale(0.0);
   const Eigen::VectorXd start = equations.stuck_solution(frequency_hz);
+  const double extent = std::max((target * homotopy.lin_).norm(), (stuck_end - start).norm());
+  if (std::isfinite(extent) && extent > 0) o.x_scale = Eigen::VectorXd::Constant(start.size(), extent / kPathUnits);
   continuation::Branch b = continuation::trace(homotopy, start, o);
   equations.set_excitation_scale(saved);
   if (b.status == continuation::BranchStatus::kReachedEnd) w = b.points.back().x;

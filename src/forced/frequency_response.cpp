@@ -49,9 +49,12 @@ constexpr double kPeakTolerance = 1e-10;
 // envelope (a parabola through the three sampled points) is within kRippleBand of the located
 // maximum, at kTopSamples points, then Brent's method at the kTopCandidates largest sampled
 // local maxima. Where the samples show a ripple above half the band, the band is widened to
-// twice it, once. The samples are corrected at the tracing tolerance (they only pick the
-// candidates; Brent's method at the candidates uses the tight one): on the paper's preload
-// study that took the peak location from 87 to 49 s, the largest peaks the same to 1e-10.
+// twice it, once; the wider band samples only what the narrower one left out. The samples
+// are corrected at the tracing tolerance (they only pick the candidates; Brent's method at the
+// candidates uses the tight one): on the paper's preload study that took the peak location
+// from 87 to 49 s, the largest peaks the same to 1e-10; sampling only the new part of a wider
+// band and warm-starting Brent's trials from the best one so far, from 46 to 31 s
+// (docs/continuation.md, "Peaks").
 constexpr double kRippleBand = 1e-5;  // relative to the peak amplitude
 constexpr int kTopSamples = 100;
 constexpr int kTopCandidates = 3;
@@ -79,15 +82,18 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
   const double c2 = (d12 - d01) / (l2 - l0);
   if (!(c2 < 0) || !best.found) return best;
   double band = kRippleBand;
+  struct Sample {
+    continuation::Extremum e;
+    int step;
+    bool refined = false;  // Brent's method has run at it
+  };
+  std::vector<Sample> samples;                               // every pass's, ordered by step, then by s
+  std::array<double, 2> a_done{0.0, 0.0}, b_done{0.0, 0.0};  // the s already sampled, per step
+  std::array<bool, 2> sampled{false, false};
   for (int pass = 0; pass < 2; ++pass) {
     const double half_width = std::sqrt(band * best.value / -c2);
     const double lo = best.lambda - half_width, hi = best.lambda + half_width;
     const double spacing = (hi - lo) / kTopSamples;
-    struct Sample {
-      continuation::Extremum e;
-      int step;
-    };
-    std::vector<Sample> samples;
     for (int k = 0; k < 2; ++k) {
       if (!(lengths[k] > 0)) continue;
       // s along step k, linear in frequency between its ends (which may run downwards).
@@ -97,13 +103,27 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
       const double a = std::min(s_at_lo, s_at_hi), b = std::max(s_at_lo, s_at_hi);
       const int n = static_cast<int>(std::ceil((b - a) / (lengths[k] * spacing / std::abs(lb - la))));
       if (n < 1) continue;
-      std::vector<double> s;
-      for (int j = 0; j <= n; ++j) s.push_back(a + (b - a) * j / n);
-      for (continuation::Extremum& e : continuation::sample_along(equations, scan, *pts[k], s, amplitude)) {
-        evaluations += e.evaluations;
-        samples.push_back({std::move(e), k});
+      // A wider band samples only what the narrower one did not (there it was finer).
+      std::vector<double> below, above;
+      for (int j = 0; j <= n; ++j) {
+        const double sj = a + (b - a) * j / n;
+        if (!sampled[k] || sj < a_done[k]) below.push_back(sj);
+        else if (sj > b_done[k]) above.push_back(sj);
+      }
+      a_done[k] = sampled[k] ? std::min(a, a_done[k]) : a;
+      b_done[k] = sampled[k] ? std::max(b, b_done[k]) : b;
+      sampled[k] = true;
+      for (const std::vector<double>* part : {&below, &above}) {
+        if (part->empty()) continue;
+        for (continuation::Extremum& e : continuation::sample_along(equations, scan, *pts[k], *part, amplitude)) {
+          evaluations += e.evaluations;
+          samples.push_back({std::move(e), k});
+        }
       }
     }
+    std::stable_sort(samples.begin(), samples.end(), [](const Sample& p, const Sample& q) {
+      return p.step != q.step ? p.step < q.step : p.e.s < q.e.s;
+    });
     // The ripple: the largest departure of the found samples from their own least-squares
     // parabola in the frequency (centred and scaled to the band).
     const auto n_found = std::count_if(samples.begin(), samples.end(), [](const Sample& q) { return q.e.found; });
@@ -116,7 +136,8 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
       v.row(row) << 1.0, t, t * t;
       rhs[row++] = q.e.value;
     }
-    // Brent's method at the largest sampled local maxima (neighbours on the same step).
+    // Brent's method at the largest sampled local maxima (neighbours on the same step) that
+    // it has not run at yet.
     std::vector<std::size_t> candidates;
     for (std::size_t j = 1; j + 1 < samples.size(); ++j) {
       const Sample &p = samples[j - 1], &q = samples[j], &r = samples[j + 1];
@@ -127,12 +148,14 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
               [&](std::size_t a, std::size_t b) { return samples[a].e.value > samples[b].e.value; });
     if (candidates.size() > static_cast<std::size_t>(kTopCandidates)) candidates.resize(kTopCandidates);
     for (std::size_t j : candidates) {
-      keep_larger(best, samples[j].e);
+      if (samples[j].refined) continue;
+      samples[j].refined = true;
       const int k = samples[j].step;
       const continuation::Extremum e = continuation::locate_maximum(equations, fine, *pts[k], samples[j - 1].e.s,
                                                                     samples[j + 1].e.s, amplitude, 1e-7, &samples[j].e);
       evaluations += e.evaluations;
-      keep_larger(best, e);
+      // The sample itself (at the tracing tolerance) counts only where Brent's method fails.
+      keep_larger(best, e.found ? e : samples[j].e);
     }
     if (v.rows() < 4) break;
     const Eigen::VectorXd coef = v.colPivHouseholderQr().solve(rhs);
@@ -169,8 +192,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   if (eo.n_harmonics > 1) {
     // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
     // each new harmonic starting at zero (higher harmonics are small corrections).
-    say(info, "frf: start point at " + shortest(f) + " Hz by harmonic stepping (H = 1 .. " +
-                  std::to_string(eo.n_harmonics) + ")");
+    say(info, "frf: no start at " + shortest(f) + " Hz from the stuck or the free state; trying harmonic stepping");
     Eigen::VectorXd prev;
     int prev_h = 0;
     for (int h = 1; h <= eo.n_harmonics; ++h) {
@@ -206,10 +228,13 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
     }
     if (prev_h == eo.n_harmonics) {
       how = "harmonic stepping";
+      say(info, "frf: start point at " + shortest(f) + " Hz by harmonic stepping (H = 1 .. " +
+                    std::to_string(eo.n_harmonics) + ")");
       return prev;
     }
   }
   how = "excitation homotopy";
+  say(info, "frf: no start at " + shortest(f) + " Hz by Newton; trying the continuation in the excitation level");
   start = equations.stuck_solution(f);
   const continuation::Branch h = solve_by_excitation_homotopy(equations, f, ao, start);
   if (h.status != continuation::BranchStatus::kReachedEnd)

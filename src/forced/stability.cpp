@@ -108,12 +108,7 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
   const Eigen::Index s = offset.back();
   if (s == 0) throw NumericalError("no modes for the Floquet analysis");
   out.hill_size = static_cast<int>(2 * s);
-  if (out.hill_size > max_size) {
-    out.reason = "the Hill eigenproblem would be " + std::to_string(out.hill_size) + " wide (2 DOFs (2H + 1)), above " +
-                 std::to_string(max_size) + " (forced/stability.hpp kMaxHillSize)";
-    return out;
-  }
-  const bool massless_mean = form(0).M.rows() != form(1).M.rows();
+  // The model's reason first: a sector is refused whatever its size.
   if (form(1).own_coordinates_per_harmonic && !allow_sector) {
     out.reason =
         "not analysed for an FE sector (validated for lumped models): each harmonic lives in its own harmonic "
@@ -121,6 +116,13 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
         "would go unjudged (docs/physics.md section 9)";
     return out;
   }
+  if (out.hill_size > max_size) {
+    out.reason = "the Hill eigenproblem would be " + std::to_string(out.hill_size) +
+                 " wide (twice the second-order unknowns of the 2H + 1 harmonics), above " + std::to_string(max_size) +
+                 " (forced/stability.hpp kMaxHillSize)";
+    return out;
+  }
+  const bool massless_mean = form(0).M.rows() != form(1).M.rows();
   out.available = true;
 
   // D in exponential coefficients: index (k + H) c + 3 p + d. Per pair and direction, the real
