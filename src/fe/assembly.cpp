@@ -89,19 +89,32 @@ void Assembler::assemble_range(const Material& material, int begin, int end, dou
   }
 }
 
+namespace {
+// Slices of the parallel assembly: at least this many elements each, and at most kMaxSlices
+// (each slice past the first holds a copy of the K and M values: 2 nnz doubles).
+constexpr int kElementsPerSlice = 500;
+constexpr int kMaxSlices = 2;
+}  // namespace
+
 linalg::SparsePair<double> Assembler::assemble(const Material& material, int threads) const {
   SHROUDSIM_CHECK(material.valid(), "Assembler::assemble: invalid material");
   const mesh::Mesh& mesh = *mesh_;
   linalg::SparsePair<double> km{pattern_, pattern_};
   const int n_el = mesh.n_elements();
+  // The elements are split into a number of slices that depends on the mesh only, each
+  // scattered into its own value arrays (no locks; slice 0 into km itself) and the slices summed
+  // in order, so K and M are the same to the last bit whatever the thread count (the threads
+  // only share out the slices). Summing per thread instead made K differ in round-off between
+  // --threads 1 and 2 from 1,000 elements on, and with it the path of every curve traced on the
+  // sector (docs/continuation.md, "Determinism").
+  const int n_slices = std::clamp(n_el / kElementsPerSlice, 1, kMaxSlices);
   int n_threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  n_threads = std::clamp(n_threads, 1, std::max(1, n_el / 500));
-  // Each thread scatters into its own value arrays (no locks); thread 0 into km itself.
-  std::vector<std::vector<double>> k_extra(n_threads - 1), m_extra(n_threads - 1);
-  std::vector<int> bad(n_threads, -1);
-  auto run = [&](int t) {
-    const int begin = static_cast<int>(static_cast<long>(n_el) * t / n_threads);
-    const int end = static_cast<int>(static_cast<long>(n_el) * (t + 1) / n_threads);
+  n_threads = std::clamp(n_threads, 1, n_slices);
+  std::vector<std::vector<double>> k_extra(n_slices - 1), m_extra(n_slices - 1);
+  std::vector<int> bad(n_slices, -1);
+  auto slice = [&](int t) {
+    const int begin = static_cast<int>(static_cast<long>(n_el) * t / n_slices);
+    const int end = static_cast<int>(static_cast<long>(n_el) * (t + 1) / n_slices);
     double* kv = km.K.valuePtr();
     double* mv = km.M.valuePtr();
     if (t > 0) {
@@ -113,16 +126,20 @@ linalg::SparsePair<double> Assembler::assemble(const Material& material, int thr
     if (mesh.nodes_per_element() == 4) assemble_range<4>(material, begin, end, kv, mv, &bad[t]);
     else assemble_range<10>(material, begin, end, kv, mv, &bad[t]);
   };
+  // Thread t takes slices t, t + n_threads, ...
+  auto run = [&](int t) {
+    for (int k = t; k < n_slices; k += n_threads) slice(k);
+  };
   std::vector<std::thread> pool;
   for (int t = 1; t < n_threads; ++t) pool.emplace_back(run, t);
   run(0);
   for (auto& th : pool) th.join();
-  for (int t = 0; t < n_threads; ++t) {
+  for (int t = 0; t < n_slices; ++t) {
     if (bad[t] >= 0)
       throw InputError("mesh: element " + std::to_string(bad[t]) +
                        " is inverted or degenerate (Jacobian determinant <= 0)");
   }
-  for (int t = 1; t < n_threads; ++t) {
+  for (int t = 1; t < n_slices; ++t) {
     Eigen::Map<Eigen::VectorXd>(km.K.valuePtr(), pattern_.nonZeros()) +=
         Eigen::Map<const Eigen::VectorXd>(k_extra[t - 1].data(), pattern_.nonZeros());
     Eigen::Map<Eigen::VectorXd>(km.M.valuePtr(), pattern_.nonZeros()) +=

@@ -6,10 +6,13 @@
 //   linalg::parallel_for(jobs, workers, [&](int i) { ...job i... });
 //
 // Each index runs once, on one of `workers` threads (the calling thread included), taken in
-// increasing order. With more than one worker the BLAS runs on one thread meanwhile
-// (linalg::SerialBlasScope): OpenBLAS's own threads on top of the workers oversubscribe the
-// cores. A job should catch its own exceptions; one that escapes is rethrown after all
-// workers have finished (the first one only).
+// increasing order. The BLAS runs on one thread meanwhile (linalg::SerialBlasScope), whatever
+// the number of workers: OpenBLAS's own threads on top of the workers oversubscribe the cores,
+// and a job's round-off must not depend on the worker count (a factorization with a threaded
+// BLAS under one worker gave other modes, to round-off, than under two: --threads 1 and 2
+// then traced different curves on the same sector; docs/continuation.md, "Determinism"). A
+// job should catch its own exceptions; one that escapes is rethrown after all workers have
+// finished (the first one only).
 #include <algorithm>
 #include <atomic>
 #include <exception>
@@ -43,10 +46,10 @@ void parallel_for(int jobs, int workers, Job&& job) {
       }
     }
   };
+  linalg::SerialBlasScope serial;
   if (workers <= 1) {
     work();
   } else {
-    linalg::SerialBlasScope serial;
     std::vector<std::thread> pool;
     for (int t = 1; t < workers; ++t) pool.emplace_back(work);
     work();
