@@ -479,8 +479,9 @@ TEST(NonlinearModes, SynthesisMatchesTheFullHarmonicBalancePeakAtThreeLevels) {
         double top = 0.0;
         for (const auto& q : synthesized) top = std::max(top, q.amplitude);
         EXPECT_NEAR(top, peak.amplitude, 1e-12 * peak.amplitude);
-        // Milliseconds at most per curve (the HB it replaces takes 0.05 to 0.2 s here).
-        EXPECT_LT(synth_seconds, 0.01);
+        // The times are printed, not asserted: a speed claim belongs to a benchmark
+        // (BENCHMARKS.md "Nonlinear modes": 9,000 to 109,000 times faster per curve on the
+        // wheel); a 10 ms bound here failed under the sanitizer build on a loaded machine.
       }
     }
   }
