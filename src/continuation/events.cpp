@@ -215,8 +215,9 @@ Extremum locate_maximum(ParametricResidual& residual, const ArclengthOptions& op
   // Each trial starts from the best trial so far (Brent's trials close in on it; before the
   // first, from `near` or the tangent line), moved along the tangent: far fewer corrector
   // iterations than from the tangent line.
-  Eigen::VectorXd y_near = near && near->found ? sys.to_scaled(near->x, near->lambda) : Eigen::VectorXd();
-  double s_near = near && near->found ? near->s : 0.0;
+  Eigen::VectorXd y_near;
+  double s_near = 0.0;
+  if (near && near->found) y_near = sys.to_scaled(near->x, near->lambda), s_near = near->s;
   auto f = [&](double s) {
     const Eigen::VectorXd y_pred = y0 + s * t0;
     Eigen::VectorXd y = y_near.size() ? Eigen::VectorXd(y_near + (s - s_near) * t0) : y_pred;

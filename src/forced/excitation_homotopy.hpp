@@ -17,10 +17,11 @@
 
 namespace shroudsim::forced {
 
-/// The continuation in s at `frequency_hz` [Hz] with `options`' tolerances and scales
-/// (lambda range, steps and point cap are set here). Returns the branch; on
-/// BranchStatus::kReachedEnd, w holds the solution at s = 1. equations' excitation scale is
-/// restored before returning.
+/// The continuation in s at `frequency_hz` [Hz] with `options`' tolerance and corrector
+/// settings (the lambda range, the x unit, the steps and the point cap are set here; the x unit
+/// from the path's own extent, the larger of the free and the stuck motion at this frequency).
+/// Returns the branch; on BranchStatus::kReachedEnd, w (output only) holds the solution at
+/// s = 1. equations' excitation scale is restored before returning.
 continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, double frequency_hz,
                                                   const continuation::ArclengthOptions& options, Eigen::VectorXd& w);
 

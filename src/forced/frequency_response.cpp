@@ -87,9 +87,10 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
     int step;
     bool refined = false;  // Brent's method has run at it
   };
-  std::vector<Sample> samples;                               // every pass's, ordered by step, then by s
-  std::array<double, 2> a_done{0.0, 0.0}, b_done{0.0, 0.0};  // the s already sampled, per step
-  std::array<bool, 2> sampled{false, false};
+  std::vector<Sample> samples;  // every pass's, ordered by step, then by s
+  // The s already sampled, per step (empty: lower end above the upper).
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::array<double, 2> a_done{kInf, kInf}, b_done{-kInf, -kInf};
   for (int pass = 0; pass < 2; ++pass) {
     const double half_width = std::sqrt(band * best.value / -c2);
     const double lo = best.lambda - half_width, hi = best.lambda + half_width;
@@ -107,12 +108,11 @@ continuation::Extremum search_rippled_top(ReducedEquations& equations, const con
       std::vector<double> below, above;
       for (int j = 0; j <= n; ++j) {
         const double sj = a + (b - a) * j / n;
-        if (!sampled[k] || sj < a_done[k]) below.push_back(sj);
+        if (sj < a_done[k]) below.push_back(sj);
         else if (sj > b_done[k]) above.push_back(sj);
       }
-      a_done[k] = sampled[k] ? std::min(a, a_done[k]) : a;
-      b_done[k] = sampled[k] ? std::max(b, b_done[k]) : b;
-      sampled[k] = true;
+      a_done[k] = std::min(a, a_done[k]);
+      b_done[k] = std::max(b, b_done[k]);
       for (const std::vector<double>* part : {&below, &above}) {
         if (part->empty()) continue;
         for (continuation::Extremum& e : continuation::sample_along(equations, scan, *pts[k], *part, amplitude)) {
@@ -206,7 +206,6 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
       if (h == 1) {
         w = step_equations.stuck_solution(f);
         if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
-          w = step_equations.stuck_solution(f);
           if (solve_by_excitation_homotopy(step_equations, f, so, w).status != continuation::BranchStatus::kReachedEnd)
             break;
         }
@@ -235,7 +234,6 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   }
   how = "excitation homotopy";
   say(info, "frf: no start at " + shortest(f) + " Hz by Newton; trying the continuation in the excitation level");
-  start = equations.stuck_solution(f);
   const continuation::Branch h = solve_by_excitation_homotopy(equations, f, ao, start);
   if (h.status != continuation::BranchStatus::kReachedEnd)
     throw NumericalError(
