@@ -84,37 +84,49 @@ linalg::DenseEigen hill_eigen(const Eigen::MatrixXcd& companion, const std::vect
 double FloquetResult::spectral_radius(double frequency_hz) const { return std::exp(max_real / frequency_hz); }
 
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
-                                ExponentSelection selection, int max_size, bool allow_sector) {
+                                ExponentSelection selection, int max_size, double mode_cutoff) {
+  return floquet_exponents(equations.linear_part(), equations.pair_layout(), equations.contact_jacobian(w),
+                           frequency_hz, selection, max_size, mode_cutoff);
+}
+
+FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::HarmonicLayout& layout,
+                                const std::vector<Eigen::MatrixXd>& blocks, double frequency_hz,
+                                ExponentSelection selection, int max_size, double mode_cutoff) {
   FloquetResult out;
-  const frf::LinearPart& linear = equations.linear_part();
-  const hbm::HarmonicLayout& layout = equations.pair_layout();
-  const int h = layout.n_harmonics(), nd = layout.n_directions(), pairs = equations.n_pairs();
+  const int h = layout.n_harmonics(), nd = layout.n_directions(), pairs = static_cast<int>(blocks.size());
   const int c = linear.n_contact(), nk = 2 * h + 1, ne = c * nk;
   const double omega = kTwoPi * frequency_hz;
+  // Modal forms keep the modes up to mode_cutoff (H + 1) w in the Hill problem (the others enter
+  // R with their receptance at each harmonic: exact at lambda = 0); other forms keep everything.
+  const double max_omega = mode_cutoff * (h + 1) * omega;
 
-  // The second-order form of every harmonic 0..H (k < 0: the conjugate).
-  std::vector<frf::SecondOrderForm> forms(static_cast<std::size_t>(h + 1));
-  for (int n = 0; n <= h; ++n)
-    if (!linear.second_order_form(n, forms[static_cast<std::size_t>(n)])) {
-      out.reason =
-          "the linear part has no second-order form (lumped models and FE sectors have one) "
-          "(docs/physics.md section 9)";
-      return out;
-    }
-  auto form = [&](int k) -> const frf::SecondOrderForm& { return forms[static_cast<std::size_t>(std::abs(k))]; };
-  std::vector<Eigen::Index> offset(static_cast<std::size_t>(nk + 1), 0);
-  for (int k = -h; k <= h; ++k)
-    offset[static_cast<std::size_t>(k + h + 1)] = offset[static_cast<std::size_t>(k + h)] + form(k).M.rows();
-  const Eigen::Index s = offset.back();
-  if (s == 0) throw NumericalError("no modes for the Floquet analysis");
-  out.hill_size = static_cast<int>(2 * s);
-  // The model's reason first: a sector is refused whatever its size.
-  if (form(1).own_coordinates_per_harmonic && !allow_sector) {
+  out.families = linear.perturbation_families();
+  std::vector<std::vector<frf::SecondOrderForm>> forms(out.families.size());
+  for (std::size_t f = 0; f < out.families.size(); ++f) {
+    forms[f].resize(static_cast<std::size_t>(nk));
+    for (int k = -h; k <= h; ++k)
+      if (!linear.perturbation_form(out.families[f], k, omega, max_omega, forms[f][static_cast<std::size_t>(k + h)])) {
+        out.reason =
+            "the linear part has no second-order form (lumped models and FE sectors have one) "
+            "(docs/physics.md section 9)";
+        return out;
+      }
+  }
+  if (out.families.empty()) {
     out.reason =
-        "not analysed for an FE sector (validated for lumped models): each harmonic lives in its own harmonic "
-        "index, so the exponents have no copies to select from and the resonant family's complex exponents "
-        "would go unjudged (docs/physics.md section 9)";
+        "no perturbation family has modes in all its blocks: an FE sector needs the modes of harmonic index 0 and "
+        "of every index p + k m its blocks reach (docs/physics.md section 9)";
     return out;
+  }
+  // The sizes first: a point too large is not analysed, whatever else.
+  std::vector<std::vector<Eigen::Index>> offsets(out.families.size());
+  for (std::size_t f = 0; f < out.families.size(); ++f) {
+    std::vector<Eigen::Index>& offset = offsets[f];
+    offset.assign(static_cast<std::size_t>(nk + 1), 0);
+    for (int k = -h; k <= h; ++k)
+      offset[static_cast<std::size_t>(k + h + 1)] =
+          offset[static_cast<std::size_t>(k + h)] + forms[f][static_cast<std::size_t>(k + h)].M.rows();
+    out.hill_size = std::max(out.hill_size, static_cast<int>(2 * offset.back()));
   }
   if (out.hill_size > max_size) {
     out.reason = "the Hill eigenproblem would be " + std::to_string(out.hill_size) +
@@ -122,13 +134,22 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
                  " (forced/stability.hpp kMaxHillSize)";
     return out;
   }
-  const bool massless_mean = form(0).M.rows() != form(1).M.rows();
+  const bool massless = std::any_of(forms.begin(), forms.end(), [](const auto& family) {
+    return std::any_of(family.begin(), family.end(), [](const auto& f) { return f.R.size() > 0 && !f.R.isZero(0.0); });
+  });
+  if (massless && ne > kMaxCondensedSize) {
+    out.reason = "the contact condensation of the massless part would be " + std::to_string(ne) +
+                 " wide (3 pairs x (2H + 1)), above " + std::to_string(kMaxCondensedSize) +
+                 " (forced/stability.hpp kMaxCondensedSize)";
+    return out;
+  }
   out.available = true;
+  out.selection = selection;
 
   // D in exponential coefficients: index (k + H) c + 3 p + d. Per pair and direction, the real
   // coefficients [c0 | c1 s1 | ...] map to X_0 = c0, X_n = (c_n - i s_n) / 2,
-  // X_-n = (c_n + i s_n) / 2, and back c_n = X_n + X_-n, s_n = i (X_n - X_-n).
-  const std::vector<Eigen::MatrixXd> blocks = equations.contact_jacobian(w);
+  // X_-n = (c_n + i s_n) / 2, and back c_n = X_n + X_-n, s_n = i (X_n - X_-n). The map is
+  // complex-linear, so it also holds for a family's complex perturbation.
   const int b = layout.size();
   Eigen::MatrixXcd t = Eigen::MatrixXcd::Zero(b, b), t_inv = Eigen::MatrixXcd::Zero(b, b);
   const Complex i1(0.0, 1.0);
@@ -154,78 +175,92 @@ FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::Vector
           for (int k2 = -h; k2 <= h; ++k2)
             dx((k1 + h) * c + 3 * p + d1, (k2 + h) * c + 3 * p + d2) = local(d1 * nk + k1 + h, d2 * nk + k2 + h);
   }
-  // E = D (I + R D)^-1 = (I + D R)^-1 D, R block diagonal over k.
-  Eigen::MatrixXcd dr = Eigen::MatrixXcd::Zero(ne, ne);
-  bool massless = false;
-  for (int k = -h; k <= h; ++k) {
-    const Eigen::MatrixXcd r = k < 0 ? Eigen::MatrixXcd(form(k).R.conjugate()) : form(k).R;
-    if (r.size() == 0 || r.isZero(0.0)) continue;
-    massless = true;
-    dr.middleCols((k + h) * c, c) = dx.middleCols((k + h) * c, c) * r;
-  }
-  Eigen::MatrixXcd e = dx;
-  if (massless) e = (Eigen::MatrixXcd::Identity(ne, ne) + dr).partialPivLu().solve(dx);
-
-  // Phi = blockdiag(P_k); A0, A1, A2 over the modal unknowns, scaled by w (mu = lambda / w).
-  Eigen::MatrixXcd phi = Eigen::MatrixXcd::Zero(ne, s);
-  Eigen::MatrixXcd a0 = Eigen::MatrixXcd::Zero(s, s), a1 = Eigen::MatrixXcd::Zero(s, s);
-  Eigen::MatrixXd a2 = Eigen::MatrixXd::Zero(s, s);
-  for (int k = -h; k <= h; ++k) {
-    const frf::SecondOrderForm& f = form(k);
-    const Eigen::Index o = offset[static_cast<std::size_t>(k + h)], m = f.M.rows();
-    if (m == 0) continue;
-    phi.block((k + h) * c, o, c, m) = k < 0 ? Eigen::MatrixXcd(f.P.conjugate()) : f.P;
-    const double kw = k * omega;
-    a0.block(o, o, m, m) =
-        (f.K.cast<Complex>() + i1 * kw * f.C.cast<Complex>() - kw * kw * f.M.cast<Complex>()) / (omega * omega);
-    a1.block(o, o, m, m) = (f.C.cast<Complex>() + 2.0 * i1 * kw * f.M.cast<Complex>()) / omega;
-    a2.block(o, o, m, m) = f.M;
-  }
-  a0 += phi.adjoint() * e * phi / (omega * omega);
-  // Companion form: [0 I; -A2^-1 A0  -A2^-1 A1] [q; mu q] = mu [q; mu q].
-  const Eigen::PartialPivLU<Eigen::MatrixXcd> a2_lu(a2.cast<Complex>());
-  Eigen::MatrixXcd companion = Eigen::MatrixXcd::Zero(2 * s, 2 * s);
-  companion.topRightCorner(s, s).setIdentity();
-  companion.bottomLeftCorner(s, s) = -a2_lu.solve(a0);
-  companion.bottomRightCorner(s, s) = -a2_lu.solve(a1);
-  if (!companion.allFinite()) throw NumericalError("the Hill matrix is not finite");
-  // The symmetric copy of an exponent has its eigenvector on harmonic 0's block: a model whose
-  // harmonic 0 has other (fewer) DOFs than harmonic 1 (an FE sector: harmonic 0 is static,
-  // massless) has no such copy, and the exponents nearest the real axis are taken instead.
-  if (massless_mean) selection = ExponentSelection::imaginary;
-  out.selection = selection;
-  const bool vectors = selection == ExponentSelection::symmetry;
   // Hill problems are a few hundred wide: OpenBLAS's threads inside LAPACK cost more than they
   // save there (stress model 7, Hill size 190: 76 s threaded against 21 s serial on a busy
   // 2-core machine).
   const linalg::SerialBlasScope serial;
-  const linalg::DenseEigen solver = hill_eigen(companion, offset, h, vectors);
-  const Eigen::VectorXcd& mu = solver.values;
 
-  std::vector<Complex> chosen;
-  if (selection == ExponentSelection::symmetry) {
-    for (Eigen::Index j = 0; j < mu.size(); ++j) {
-      const auto q = solver.vectors.col(j).head(s);
-      double total = 0.0, moment = 0.0;
-      for (int k = -h; k <= h; ++k) {
-        const Eigen::Index o = offset[static_cast<std::size_t>(k + h)];
-        const double wk = q.segment(o, offset[static_cast<std::size_t>(k + h + 1)] - o).squaredNorm();
-        total += wk;
-        moment += k * wk;
-      }
-      if (total > 0.0 && std::abs(moment / total) <= kCentroidHalfWidth) chosen.push_back(mu[j]);
+  struct Chosen {
+    Complex mu;
+    int family;
+  };
+  std::vector<Chosen> chosen;
+  for (std::size_t f = 0; f < out.families.size(); ++f) {
+    auto form = [&](int k) -> const frf::SecondOrderForm& { return forms[f][static_cast<std::size_t>(k + h)]; };
+    const std::vector<Eigen::Index>& offset = offsets[f];
+    const Eigen::Index s = offset.back();
+    if (s == 0) continue;  // every mode of the family quasi-static: no exponent
+    // E = D (I + R D)^-1 = (I + D R)^-1 D, R block diagonal over k.
+    Eigen::MatrixXcd dr = Eigen::MatrixXcd::Zero(ne, ne);
+    bool with_r = false;
+    for (int k = -h; k <= h; ++k) {
+      const Eigen::MatrixXcd& r = form(k).R;
+      if (r.size() == 0 || r.isZero(0.0)) continue;
+      with_r = true;
+      dr.middleCols((k + h) * c, c) = dx.middleCols((k + h) * c, c) * r;
     }
-  } else {
-    std::vector<Complex> all(mu.data(), mu.data() + mu.size());
-    std::sort(all.begin(), all.end(), [](Complex a, Complex b) { return std::abs(a.imag()) < std::abs(b.imag()); });
-    const std::size_t keep = std::min(all.size(), static_cast<std::size_t>(2 * form(1).M.rows()));
-    chosen.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep));
+    Eigen::MatrixXcd e = dx;
+    if (with_r) e = (Eigen::MatrixXcd::Identity(ne, ne) + dr).partialPivLu().solve(dx);
+
+    // Phi = blockdiag(P_k); A0, A1, A2 over the modal unknowns, scaled by w (mu = lambda / w).
+    Eigen::MatrixXcd phi = Eigen::MatrixXcd::Zero(ne, s);
+    Eigen::MatrixXcd a0 = Eigen::MatrixXcd::Zero(s, s), a1 = Eigen::MatrixXcd::Zero(s, s);
+    Eigen::MatrixXd a2 = Eigen::MatrixXd::Zero(s, s);
+    for (int k = -h; k <= h; ++k) {
+      const frf::SecondOrderForm& fk = form(k);
+      const Eigen::Index o = offset[static_cast<std::size_t>(k + h)], m = fk.M.rows();
+      if (m == 0) continue;
+      phi.block((k + h) * c, o, c, m) = fk.P;
+      const double kw = k * omega;
+      a0.block(o, o, m, m) =
+          (fk.K.cast<Complex>() + i1 * kw * fk.C.cast<Complex>() - kw * kw * fk.M.cast<Complex>()) / (omega * omega);
+      a1.block(o, o, m, m) = (fk.C.cast<Complex>() + 2.0 * i1 * kw * fk.M.cast<Complex>()) / omega;
+      a2.block(o, o, m, m) = fk.M;
+    }
+    a0 += phi.adjoint() * e * phi / (omega * omega);
+    // Companion form: [0 I; -A2^-1 A0  -A2^-1 A1] [q; mu q] = mu [q; mu q].
+    const Eigen::PartialPivLU<Eigen::MatrixXcd> a2_lu(a2.cast<Complex>());
+    Eigen::MatrixXcd companion = Eigen::MatrixXcd::Zero(2 * s, 2 * s);
+    companion.topRightCorner(s, s).setIdentity();
+    companion.bottomLeftCorner(s, s) = -a2_lu.solve(a0);
+    companion.bottomRightCorner(s, s) = -a2_lu.solve(a1);
+    if (!companion.allFinite()) throw NumericalError("the Hill matrix is not finite");
+    const bool vectors = selection == ExponentSelection::symmetry;
+    const linalg::DenseEigen solver = hill_eigen(companion, offset, h, vectors);
+    const Eigen::VectorXcd& mu = solver.values;
+    const int family = out.families[f];
+    if (selection == ExponentSelection::symmetry) {
+      for (Eigen::Index j = 0; j < mu.size(); ++j) {
+        const auto q = solver.vectors.col(j).head(s);
+        double total = 0.0, moment = 0.0;
+        for (int k = -h; k <= h; ++k) {
+          const Eigen::Index o = offset[static_cast<std::size_t>(k + h)];
+          // Weighted by the block's mass (kinetic-energy-like, q_k^H M_k q_k): the same centroid
+          // in any coordinates (modal, M = I, or physical), so a sector's families and the full
+          // wheel keep the same exponents (tests/forced/test_cyclic_stability.cpp).
+          const auto qk = q.segment(o, offset[static_cast<std::size_t>(k + h + 1)] - o);
+          const double wk = (qk.adjoint() * form(k).M.cast<Complex>() * qk).real()(0, 0);
+          total += wk;
+          moment += k * wk;
+        }
+        if (total > 0.0 && std::abs(moment / total) <= kCentroidHalfWidth) chosen.push_back({mu[j], family});
+      }
+    } else {
+      std::vector<Complex> all(mu.data(), mu.data() + mu.size());
+      std::sort(all.begin(), all.end(), [](Complex a, Complex b) { return std::abs(a.imag()) < std::abs(b.imag()); });
+      const std::size_t keep = std::min(all.size(), static_cast<std::size_t>(2 * form(0).M.rows()));
+      for (std::size_t j = 0; j < keep; ++j) chosen.push_back({all[j], family});
+    }
   }
   if (chosen.empty()) throw NumericalError("no Floquet exponent selected");
-  std::sort(chosen.begin(), chosen.end(), [](Complex a, Complex b) { return a.real() > b.real(); });
-  for (const Complex& m : chosen) out.exponents.push_back(m * omega);
+  std::stable_sort(chosen.begin(), chosen.end(),
+                   [](const Chosen& a, const Chosen& b) { return a.mu.real() > b.mu.real(); });
+  for (const Chosen& m : chosen) {
+    out.exponents.push_back(m.mu * omega);
+    out.exponent_family.push_back(m.family);
+  }
   out.max_real = out.exponents.front().real();
-  out.stable = chosen.front().real() <= kNeutralTolerance;
+  out.stable = chosen.front().mu.real() <= kNeutralTolerance;
   return out;
 }
 
@@ -250,6 +285,7 @@ std::vector<StabilityChange> stability_changes(const std::vector<FloquetResult>&
     const double im = std::abs(unstable.exponents.front().imag()) / w;
     StabilityChange c;
     c.point = i;
+    c.family = unstable.exponent_family.empty() ? 0 : unstable.exponent_family.front();
     c.kind = im < kKindTolerance                   ? StabilityChange::Kind::fold
              : std::abs(im - 0.5) < kKindTolerance ? StabilityChange::Kind::period_doubling
                                                    : StabilityChange::Kind::neimark_sacker;

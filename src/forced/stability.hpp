@@ -18,15 +18,19 @@
 // eigenvalues hold each Floquet exponent 2H + 1 times, shifted by i k w; the truncation spoils
 // the copies whose eigenvectors crowd the outer harmonics. Selection:
 //   symmetry  (default) the exponents whose eigenvector's harmonic centroid
-//             sum_k k |q_k|^2 / sum_k |q_k|^2 lies within half a harmonic of 0;
-//   imaginary the 2 m exponents nearest the real axis (m = size of the k = 1 block); used
-//             whenever the k = 0 block has another size than k = 1 (an FE sector in modal
-//             coordinates: k = 0 is massless, its modes all in R, so no exponent's copy lives
-//             there; the selected ones are those of the modes near resonance and the real
-//             exponents of folds).
-// FE sector (frf::SectorLinearPart): modal coordinates of the harmonic index of each k (the
-// perturbation keeps the response's travelling-wave pattern: a perturbation of another nodal
-// diameter is not analysed), the residual flexibility as the massless R above.
+//             sum_k k q_k^H M_k q_k / sum_k q_k^H M_k q_k (mass-weighted: the same in any
+//             coordinates) lies within half a harmonic of 0;
+//   imaginary the 2 m exponents nearest the real axis (m = size of the k = 0 block), to compare.
+// FE sector (frf::SectorLinearPart): a perturbation of the travelling-wave solution splits into
+// families p = 0..Nb - 1: block k of family p holds the modes of harmonic index p + k m mod Nb
+// (the contact Jacobian couples harmonic k to k + j in index + j m, as the solution's own
+// harmonics). Family p's exponents have no copies within the family: the copy shifted by i w
+// lives in family p + m. So every family p = 0..Nb/2 is solved (Nb - p is its conjugate) and
+// each keeps the exponents centred on its block 0 (the symmetry selection): each exponent is
+// judged once, in the family of the index it lives in. Modal forms keep the modes up to
+// kModeCutoff (H + 1) w; the others, with the residual flexibility, form the massless R,
+// with their receptance at s = i k w (the problem stays exact at lambda = 0, where a fold's
+// exponent crosses).
 // The point is unstable when the largest real part of the selected exponents exceeds
 // kNeutralTolerance w. Floquet multipliers are exp(lambda T).
 #include <Eigen/Core>
@@ -48,6 +52,16 @@ constexpr double kNeutralTolerance = 1e-9;
 /// result says why) rather than multiplying the forced response's time.
 constexpr int kMaxHillSize = 400;
 
+/// Modes of a modal form above kModeCutoff (H + 1) w leave the Hill problem for the massless
+/// part, each with its receptance at the block's harmonic: they cover the sum and difference
+/// combinations w_i +- w_j = k w (|k| <= H) of the modes below (H + 1) w, and the cost falls with
+/// the cube of the kept modes (docs/physics.md section 9).
+constexpr double kModeCutoff = 2.0;
+
+/// The largest contact condensation E = D (I + R D)^-1 (3 pairs x (2H + 1) wide, complex LU per
+/// family and point); larger problems are not analysed.
+constexpr int kMaxCondensedSize = 600;
+
 enum class ExponentSelection { symmetry, imaginary };
 
 struct FloquetResult {
@@ -57,28 +71,36 @@ struct FloquetResult {
   /// The selected Floquet exponents lambda [1/s], by decreasing real part.
   std::vector<std::complex<double>> exponents;
   double max_real = 0.0;  ///< Re of the first one [1/s]
-  int hill_size = 0;      ///< dimension of the companion eigenproblem
-  /// The selection used: `imaginary` whenever harmonic 0 has other DOFs than harmonic 1 (an
-  /// FE sector, whose harmonic 0 is the massless static flexibility): there the symmetric
-  /// copy does not exist.
+  /// The perturbation family of each exponent (an FE sector: the harmonic index p = 0..Nb/2 of
+  /// its block 0, standing also for Nb - p with the conjugate exponent; lumped: 0).
+  std::vector<int> exponent_family;
+  std::vector<int> families;  ///< the families analysed
+  int hill_size = 0;          ///< dimension of the largest companion eigenproblem
   ExponentSelection selection = ExponentSelection::symmetry;
   /// The largest Floquet multiplier modulus, exp(max_real T).
   double spectral_radius(double frequency_hz) const;
 };
 
-/// The Floquet exponents of the solution w of `equations` at frequency f [Hz]. An FE sector
-/// (frf::SecondOrderForm::own_coordinates_per_harmonic) is not analysed (available false,
-/// reason says why) unless allow_sector: its exponents are exact for stuck contacts (tests),
-/// but the selection does not yet judge every exponent (docs/physics.md section 9).
+/// The Floquet exponents of the solution w of `equations` at frequency f [Hz], over the
+/// perturbation families the linear part holds (frf::LinearPart::perturbation_families); a
+/// modal form keeps its modes up to mode_cutoff (H + 1) w (0: every mode).
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
                                 ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize,
-                                bool allow_sector = false);
+                                double mode_cutoff = kModeCutoff);
+/// The same from the contact Jacobian's blocks at the solution (ReducedEquations::contact_jacobian,
+/// one dF_p/dW_p per pair in `layout`): it touches no state of the equations, so several points
+/// can be analysed at once.
+FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::HarmonicLayout& layout,
+                                const std::vector<Eigen::MatrixXd>& jacobian, double frequency_hz,
+                                ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize,
+                                double mode_cutoff = kModeCutoff);
 
 /// Where the stability changes between two neighbouring points of a branch.
 struct StabilityChange {
   enum class Kind { fold, period_doubling, neimark_sacker };
   Kind kind = Kind::fold;
-  std::size_t point = 0;                         ///< the change lies between point and point + 1
+  std::size_t point = 0;  ///< the change lies between point and point + 1
+  int family = 0;         ///< the perturbation family of the critical exponent (FE sector: its harmonic index)
   double frequency_hz = 0.0, amplitude_m = 0.0;  ///< linear interpolation where max_real crosses 0
 };
 std::string to_string(StabilityChange::Kind kind);

@@ -14,4 +14,13 @@ void LinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eige
   dw_lin = (plus.w_lin - minus.w_lin) / (2.0 * h);
 }
 
+bool LinearPart::perturbation_form(int family, int k, double /*w*/, double /*max_omega*/, SecondOrderForm& out) const {
+  if (family != 0 || !second_order_form(std::abs(k), out)) return false;
+  if (k < 0) {
+    out.P = out.P.conjugate().eval();
+    out.R = out.R.conjugate().eval();
+  }
+  return true;
+}
+
 }  // namespace shroudsim::frf

@@ -87,6 +87,16 @@ class LinearPart {
     (void)out;
     return false;
   }
+  /// The perturbation families of the Floquet analysis (forced/stability.hpp, docs/physics.md
+  /// section 9): a structure whose harmonics share coordinates has one, 0. An FE sector has one
+  /// per harmonic index p = 0..Nb/2 whose blocks it holds modes for (family Nb - p is the complex
+  /// conjugate of family p).
+  virtual std::vector<int> perturbation_families() const { return {0}; }
+  /// Block k (-H..H) of family p's Hill problem at fundamental circular frequency w [rad/s].
+  /// The default: second_order_form(|k|), conjugated for k < 0. A modal form may leave the
+  /// modes above max_omega [rad/s] out of M, C, K and P and add their receptance at s = i k w
+  /// to the massless R (so the problem is exact at lambda = 0); max_omega 0 keeps every mode.
+  virtual bool perturbation_form(int family, int k, double w, double max_omega, SecondOrderForm& out) const;
   /// The receptances of harmonic n >= 0 of the EPMC's autonomous system (DampedReceptance)
   /// at fundamental circular frequency w and mass-proportional damping -zeta M; with_norm
   /// (n = 1): also N, its derivatives and e. false when the model has no such form.

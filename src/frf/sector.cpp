@@ -96,7 +96,12 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
       static_.psi = ct * it->second.phi;
     }
   }
-  for (int h : needed) {
+  // Every index with modes: the harmonic balance's h_n, then the further indices the Floquet
+  // analysis's perturbation families need (perturbation_form).
+  std::vector<int> indices(needed.begin(), needed.end());
+  for (const auto& [h, b] : bases)
+    if (needed.count(h) == 0) indices.push_back(h);
+  for (int h : indices) {
     auto it = bases.find(h);
     SHROUDSIM_CHECK(it != bases.end(), "modes of harmonic index " + std::to_string(h) + " given");
     const modal::ModalBasis& b = it->second;

@@ -85,6 +85,13 @@ class SectorLinearPart : public LinearPart {
   /// (massless). n = 0: no modes, R = the static flexibility: the mean of a perturbation is
   /// taken quasi-statically, as the harmonic balance takes the mean of the motion.
   bool second_order_form(int n, SecondOrderForm& out) const override;
+  /// The families p = 0..Nb/2 whose blocks k = -H..H, in harmonic index p + k m mod Nb, all have
+  /// modes (index Nb - g is the conjugate of g; index 0 needs its modes here, not only the
+  /// static flexibility): the modes given beyond the h_n decide which families are analysed.
+  std::vector<int> perturbation_families() const override;
+  /// Block k of family p: the modal form of harmonic index p + k m mod Nb; the modes above
+  /// max_omega are moved to R with their receptance at s = i k w (docs/physics.md section 9).
+  bool perturbation_form(int family, int k, double w, double max_omega, SecondOrderForm& out) const override;
   /// The same modal form with each mode's denominator w_r^2 - W^2 + i W (2 z w_r - zeta); N and
   /// e over the modes only (the residual part is massless; e is the modal part's projection
   /// of the excitation). n = 0: the static flexibility, no derivatives.
@@ -101,6 +108,11 @@ class SectorLinearPart : public LinearPart {
   };
   /// Q_n(W) (k x k).
   Eigen::MatrixXcd receptance(int n, double w) const;
+  /// The data of harmonic index g (0..Nb-1), stored as g or as its conjugate Nb - g; nullptr
+  /// when the model has no modes of g.
+  const IndexData* index_data(int g, bool& conjugate) const;
+  /// The harmonic index of block k of perturbation family p: p + k m mod Nb.
+  int family_block_index(int family, int k) const;
 
   std::vector<SectorContactPair> pairs_;
   SectorForcing forcing_;

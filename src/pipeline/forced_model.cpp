@@ -82,6 +82,16 @@ std::vector<int> forced_harmonic_indices(const io::Case& c) {
   return {needed.begin(), needed.end()};
 }
 
+std::string sector_stability_refusal(const io::Case& c) {
+  if (c.structure.type != io::StructureType::sector) return "";
+  return "not analysed for an FE sector (docs/physics.md section 9): the analysis judges every harmonic index's "
+         "perturbations (forced::floquet_exponents over the sector's perturbation families), but its verdicts "
+         "are not yet trustworthy there: with friction the contact's linearization (the harmonic balance's) drops "
+         "the slider's memory for a perturbation at its own rate, and on the coarse test sector it calls the "
+         "solution far below resonance unstable in other harmonic indices; with frictionless contacts its "
+         "verdicts change with H (3, 5, 7)";
+}
+
 ForcedModel make_sector_model(Context& ctx) {
   const io::Case& c = ctx.config;
   const int m = c.excitation.engine_order;

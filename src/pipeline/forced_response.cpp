@@ -17,6 +17,7 @@
 #include "forced/stability.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "io/output.hpp"
+#include "linalg/parallel.hpp"
 #include "pipeline/forced_model.hpp"
 #include "pipeline/forced_shapes.hpp"
 #include "study/curves.hpp"
@@ -70,18 +71,45 @@ void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyRes
 /// how many points are unstable, the changes of stability along each piece, the time taken.
 /// A point whose analysis fails is left out (empty in frf.csv) and counted.
 std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
-                                                     forced::ReducedEquations& equations) {
+                                                     forced::ReducedEquations& equations, int threads) {
   const log::Stopwatch clock;
-  std::vector<forced::FloquetResult> out(response.points.size());
+  const std::size_t n = response.points.size();
+  std::vector<forced::FloquetResult> out(n);
   std::vector<double> freq, amp;
   int unstable = 0, failed = 0, size = 0;
   std::string failure;
-  for (std::size_t i = 0; i < response.points.size(); ++i) {
-    try {
-      out[i] = forced::floquet_exponents(equations, response.points[i].x, response.points[i].lambda);
-    } catch (const NumericalError& e) {
+  // Per batch of points: their contact Jacobians in order (the evaluator is not shared between
+  // threads), then their Hill problems in parallel. Each is a pure function of its point, so
+  // the result does not depend on the thread count; the batch bounds the Jacobians held.
+  constexpr std::size_t kBatch = 64;
+  std::vector<std::string> errors(n);
+  std::vector<std::vector<Eigen::MatrixXd>> jacobians(kBatch);
+  for (std::size_t first = 0; first < n; first += kBatch) {
+    const std::size_t count = std::min(kBatch, n - first);
+    for (std::size_t i = 0; i < count; ++i) {
+      jacobians[i].clear();
+      try {
+        jacobians[i] = equations.contact_jacobian(response.points[first + i].x);
+      } catch (const NumericalError& e) {
+        errors[first + i] = e.what();
+      }
+    }
+    const int jobs = static_cast<int>(count);
+    linalg::parallel_for(jobs, linalg::worker_count(threads, jobs), [&](int i) {
+      const std::size_t k = first + static_cast<std::size_t>(i);
+      if (!errors[k].empty()) return;
+      try {
+        out[k] = forced::floquet_exponents(equations.linear_part(), equations.pair_layout(),
+                                           jacobians[static_cast<std::size_t>(i)], response.points[k].lambda);
+      } catch (const NumericalError& e) {
+        errors[k] = e.what();
+      }
+    });
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!errors[i].empty()) {
       ++failed;
-      failure = e.what();
+      failure = errors[i];
     }
     if (!out[i].available) continue;
     unstable += out[i].stable ? 0 : 1;
@@ -263,7 +291,13 @@ ForcedResponseOutcome trace_case(Context& ctx) {
 
   const ReportedPeak peak = reported_peak(response);
   std::vector<forced::FloquetResult> stability;
-  if (c.response.stability) stability = analyse_stability(j, response, equations);
+  const std::string refusal = sector_stability_refusal(c);
+  if (c.response.stability && refusal.empty()) {
+    stability = analyse_stability(j, response, equations, ctx.threads);
+  } else if (c.response.stability) {
+    j["stability"] = {{"available", false}, {"reason", refusal}};
+    log::info("frf: stability " + refusal);
+  }
   const bool analysed = c.response.stability && j["stability"]["available"].get<bool>();
   write_frf_csv(ctx.out_dir / "frf.csv", response, c.hbm.harmonics, analysed ? &stability : nullptr);
   ctx.frf_curve.clear();

@@ -74,71 +74,21 @@ std::vector<std::vector<int>> pair_nodes(const std::vector<frf::SectorContactPai
   return nodes;
 }
 
-std::string pvd(const std::vector<std::string>& files) {
-  std::ostringstream s;
-  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-       "  <Collection>\n";
-  for (std::size_t k = 0; k < files.size(); ++k)
-    s << "    <DataSet timestep=\"" << static_cast<double>(k) / files.size() << "\" part=\"0\" file=\"" << files[k]
-      << "\"/>\n";
-  s << "  </Collection>\n</VTKFile>\n";
-  return s.str();
-}
-
 void write_sector_files(Context& ctx, const forced::ForcedModel& model, const std::vector<Shape>& shapes,
                         const std::vector<std::vector<Eigen::VectorXcd>>& forces,
                         const std::vector<std::vector<forced::PairState>>& states, std::size_t largest,
                         std::vector<Eigen::Vector3d>& positions) {
-  const io::Case& c = ctx.config;
-  // The modes again, from the stage cache (a run of its own, so that run.json keeps the forced
-  // model's modal section): the forced response itself does not hold the mode shapes.
-  Context modal_ctx;
-  modal_ctx.config = c;
-  modal_ctx.out_dir = ctx.out_dir;
-  modal_ctx.threads = ctx.threads;
-  ModalModel modal = run_modal_stage(modal_ctx, forced_harmonic_indices(c), false, c.excitation.speed_rpm);
-  if (!modal.failures.empty()) throw NumericalError("shapes: modal stage failed: " + modal.failures.front());
   std::vector<frf::ShapeLoad> loads;
   for (std::size_t s = 0; s < shapes.size(); ++s)
     loads.push_back({2.0 * std::numbers::pi * shapes[s].frequency_hz, forces[s]});
-  const std::vector<std::vector<Eigen::VectorXcd>> u = frf::sector_displacements(
-      modal.cyclic(), modal.bases, [&](int h) { return modal.stiffness_factor(h); }, model.sector_pairs,
-      *model.sector_forcing, loads);
-  const mesh::Mesh& mesh = modal.mesh;
+  const SectorShapes shaped = sector_shapes(ctx, model, loads, "shapes");
+  const mesh::Mesh& mesh = shaped.mesh;
   const Eigen::Index nodes = mesh.nodes.rows();
-  auto node_field = [&](const Eigen::VectorXd& v) {  // n_full -> n_nodes x 3
-    Eigen::MatrixXd f(nodes, 3);
-    for (Eigen::Index i = 0; i < nodes; ++i) f.row(i) = v.segment(3 * i, 3).transpose();
-    return f;
-  };
   std::vector<io::PointField> fields;
-  std::filesystem::create_directories(ctx.out_dir / "frf_frames");
   for (std::size_t s = 0; s < shapes.size(); ++s) {
-    const std::string& name = shapes[s].name;
-    auto at = [&](double theta) {  // u(theta) = Re sum_n U_n exp(i n theta)
-      Eigen::VectorXd ut = Eigen::VectorXd::Zero(u[s][0].size());
-      for (std::size_t n = 0; n < u[s].size(); ++n)
-        ut += (u[s][n] * std::polar(1.0, static_cast<double>(n) * theta)).real();
-      return node_field(ut);
-    };
-    Eigen::VectorXd amplitude = Eigen::VectorXd::Zero(nodes);
-    for (int k = 0; k < kAmplitudePoints; ++k)
-      amplitude = amplitude.cwiseMax(at(2.0 * std::numbers::pi * k / kAmplitudePoints).rowwise().norm());
-    std::vector<std::string> frames;
-    for (int k = 0; k < kFrames; ++k) {
-      const Eigen::MatrixXd f = at(2.0 * std::numbers::pi * k / kFrames);
-      char file[64];
-      std::snprintf(file, sizeof file, "%s_t%02d.vtu", name.c_str(), k);
-      io::write_point_fields_vtu(ctx.out_dir / "frf_frames" / file, mesh, {{"displacement_m", f}});
-      frames.push_back(std::string("frf_frames/") + file);
-    }
-    io::write_file_atomic(ctx.out_dir / ("frf_" + name + ".pvd"), pvd(frames));
-    if (s == largest) io::write_file_atomic(ctx.out_dir / "frf.pvd", pvd(frames));
-    for (std::size_t n = 0; n < u[s].size(); ++n) {
-      fields.push_back({name + "_u_h" + std::to_string(n) + "_re_m", node_field(u[s][n].real())});
-      fields.push_back({name + "_u_h" + std::to_string(n) + "_im_m", node_field(u[s][n].imag())});
-    }
-    fields.push_back({name + "_amplitude_m", amplitude});
+    const ShapeFiles written = write_shape(ctx.out_dir, mesh, shaped.u[s], shapes[s].name, "frf_frames",
+                                           "frf_" + shapes[s].name + ".pvd", fields);
+    if (s == largest) io::write_file_atomic(ctx.out_dir / "frf.pvd", written.pvd);
   }
   io::write_point_fields_vtu(ctx.out_dir / "frf.vtu", mesh, fields);
 
@@ -173,6 +123,76 @@ void write_sector_files(Context& ctx, const forced::ForcedModel& model, const st
 }
 
 }  // namespace
+
+SectorShapes sector_shapes(const Context& ctx, const forced::ForcedModel& model,
+                           const std::vector<frf::ShapeLoad>& loads, const std::string& what) {
+  const io::Case& c = ctx.config;
+  // The modes again, from the stage cache (a run of its own, so that run.json keeps the forced
+  // model's modal section): the forced model does not hold the mode shapes.
+  Context modal_ctx;
+  modal_ctx.config = c;
+  modal_ctx.out_dir = ctx.out_dir;
+  modal_ctx.threads = ctx.threads;
+  ModalModel modal = run_modal_stage(modal_ctx, forced_harmonic_indices(c), false, c.excitation.speed_rpm);
+  if (!modal.failures.empty()) throw NumericalError(what + ": modal stage failed: " + modal.failures.front());
+  SectorShapes out;
+  out.u = frf::sector_displacements(
+      modal.cyclic(), modal.bases, [&](int h) { return modal.stiffness_factor(h); }, model.sector_pairs,
+      *model.sector_forcing, loads);
+  out.mesh = modal.mesh;
+  return out;
+}
+
+namespace {
+std::string pvd(const std::vector<std::string>& files) {
+  std::ostringstream s;
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+       "  <Collection>\n";
+  for (std::size_t k = 0; k < files.size(); ++k)
+    s << "    <DataSet timestep=\"" << static_cast<double>(k) / files.size() << "\" part=\"0\" file=\"" << files[k]
+      << "\"/>\n";
+  s << "  </Collection>\n</VTKFile>\n";
+  return s.str();
+}
+}  // namespace
+
+ShapeFiles write_shape(const std::filesystem::path& out_dir, const mesh::Mesh& mesh,
+                       const std::vector<Eigen::VectorXcd>& u, const std::string& name, const std::string& frames_dir,
+                       const std::string& pvd_file, std::vector<io::PointField>& fields) {
+  const Eigen::Index nodes = mesh.nodes.rows();
+  auto node_field = [&](const Eigen::VectorXd& v) {  // n_full -> n_nodes x 3
+    Eigen::MatrixXd f(nodes, 3);
+    for (Eigen::Index i = 0; i < nodes; ++i) f.row(i) = v.segment(3 * i, 3).transpose();
+    return f;
+  };
+  auto at = [&](double theta) {  // u(theta) = Re sum_n U_n exp(i n theta)
+    Eigen::VectorXd ut = Eigen::VectorXd::Zero(u[0].size());
+    for (std::size_t n = 0; n < u.size(); ++n) ut += (u[n] * std::polar(1.0, static_cast<double>(n) * theta)).real();
+    return node_field(ut);
+  };
+  Eigen::VectorXd amplitude = Eigen::VectorXd::Zero(nodes);
+  for (int k = 0; k < kAmplitudePoints; ++k)
+    amplitude = amplitude.cwiseMax(at(2.0 * std::numbers::pi * k / kAmplitudePoints).rowwise().norm());
+  std::filesystem::create_directories(out_dir / frames_dir);
+  std::vector<std::string> frames;
+  for (int k = 0; k < kFrames; ++k) {
+    const Eigen::MatrixXd f = at(2.0 * std::numbers::pi * k / kFrames);
+    char file[96];
+    std::snprintf(file, sizeof file, "%s_t%02d.vtu", name.c_str(), k);
+    io::write_point_fields_vtu(out_dir / frames_dir / file, mesh, {{"displacement_m", f}});
+    frames.push_back(frames_dir + "/" + file);
+  }
+  ShapeFiles out;
+  out.pvd = pvd(frames);
+  io::write_file_atomic(out_dir / pvd_file, out.pvd);
+  for (std::size_t n = 0; n < u.size(); ++n) {
+    fields.push_back({name + "_u_h" + std::to_string(n) + "_re_m", node_field(u[n].real())});
+    fields.push_back({name + "_u_h" + std::to_string(n) + "_im_m", node_field(u[n].imag())});
+  }
+  fields.push_back({name + "_amplitude_m", amplitude});
+  out.largest_m = amplitude.maxCoeff();
+  return out;
+}
 
 void write_shapes(Context& ctx, const forced::ForcedModel& model, hbm::ContactEvaluator& evaluator,
                   forced::ReducedEquations& equations, const forced::FrequencyResponse& response) {

@@ -14,6 +14,7 @@
 #include "io/output.hpp"
 #include "io/vtu.hpp"
 #include "pipeline/forced_model.hpp"
+#include "pipeline/forced_shapes.hpp"
 #include "pipeline/modal_stage.hpp"
 
 namespace shroudsim::pipeline {
@@ -40,7 +41,8 @@ void write_nlmodes_csv(const std::filesystem::path& file, const forced::Nonlinea
 
 /// nlmodes.vtu (FE sector): the mode's displacement harmonics U_n of every sector node at the
 /// stuck start, the point of largest damping and the last point (`start_u_h<n>_re_m` ...,
-/// `<name>_amplitude_m` = max over the period of |u|), from the same modal receptance as the
+/// `<name>_amplitude_m` = max over the period of |u|), and each one's motion over a period
+/// (nlmodes_<name>.pvd, frames in nlmodes_frames/), from the same modal receptance as the
 /// equations: U_n = -X_n(w, zeta) F_n, no excitation (frf::sector_displacements).
 void write_nlmodes_vtu(Context& ctx, const forced::ForcedModel& model, hbm::ContactEvaluator& contacts,
                        const forced::NonlinearModeCurve& curve, nlohmann::json& j) {
@@ -69,49 +71,23 @@ void write_nlmodes_vtu(Context& ctx, const forced::ForcedModel& model, hbm::Cont
     }
     loads.push_back(std::move(load));
   }
-  // The modes again, from the stage cache (forced_shapes.cpp does the same).
-  Context modal_ctx;
-  modal_ctx.config = c;
-  modal_ctx.out_dir = ctx.out_dir;
-  modal_ctx.threads = ctx.threads;
-  ModalModel modal = run_modal_stage(modal_ctx, forced_harmonic_indices(c), false, c.excitation.speed_rpm);
-  if (!modal.failures.empty()) throw NumericalError("nlmodes shapes: modal stage failed: " + modal.failures.front());
-  const std::vector<std::vector<Eigen::VectorXcd>> u = frf::sector_displacements(
-      modal.cyclic(), modal.bases, [&](int h) { return modal.stiffness_factor(h); }, model.sector_pairs,
-      *model.sector_forcing, loads);
-  const mesh::Mesh& mesh = modal.mesh;
-  const Eigen::Index nodes = mesh.nodes.rows();
-  auto node_field = [&](const Eigen::VectorXd& v) {
-    Eigen::MatrixXd out(nodes, 3);
-    for (Eigen::Index i = 0; i < nodes; ++i) out.row(i) = v.segment(3 * i, 3).transpose();
-    return out;
-  };
-  constexpr int kAmplitudeSamples = 64;  // max over the period: low by at most 1 - cos(pi / 64)
+  const SectorShapes shaped = sector_shapes(ctx, model, loads, "nlmodes shapes");
   std::vector<io::PointField> fields;
   auto& shapes_json = j["shapes"];
   shapes_json = nlohmann::json::array();
   for (std::size_t s = 0; s < shapes.size(); ++s) {
     const std::string& name = shapes[s].first;
-    Eigen::VectorXd amplitude = Eigen::VectorXd::Zero(nodes);
-    for (int k = 0; k < kAmplitudeSamples; ++k) {
-      Eigen::VectorXd ut = Eigen::VectorXd::Zero(u[s][0].size());
-      for (std::size_t n = 0; n < u[s].size(); ++n)
-        ut += (u[s][n] * std::polar(1.0, 2.0 * 3.141592653589793 * static_cast<double>(n * k) / kAmplitudeSamples))
-                  .real();
-      amplitude = amplitude.cwiseMax(node_field(ut).rowwise().norm());
-    }
-    for (std::size_t n = 0; n < u[s].size(); ++n) {
-      fields.push_back({name + "_u_h" + std::to_string(n) + "_re_m", node_field(u[s][n].real())});
-      fields.push_back({name + "_u_h" + std::to_string(n) + "_im_m", node_field(u[s][n].imag())});
-    }
-    fields.push_back({name + "_amplitude_m", amplitude});
+    const ShapeFiles written =
+        write_shape(ctx.out_dir, shaped.mesh, shaped.u[s], name, "nlmodes_frames", "nlmodes_" + name + ".pvd", fields);
     const forced::NonlinearModePoint& p = curve.points[shapes[s].second];
     shapes_json.push_back({{"name", name},
                            {"amplitude", p.amplitude},
                            {"frequency_hz", p.frequency_hz},
                            {"damping_ratio", p.damping_ratio},
-                           {"largest_displacement_m", amplitude.maxCoeff()}});
+                           {"largest_displacement_m", written.largest_m},
+                           {"frames", "nlmodes_" + name + ".pvd"}});
   }
+  const mesh::Mesh& mesh = shaped.mesh;
   io::write_point_fields_vtu(ctx.out_dir / "nlmodes.vtu", mesh, fields);
 }
 

@@ -97,6 +97,17 @@ TEST(NlmodesCli, TheDefaultWheelsModeRunsEndToEndAndMeetsItsHarmonicBalance) {
   ASSERT_EQ(n["shapes"].size(), 3u);
   for (const auto& shape : n["shapes"]) EXPECT_GT(shape["largest_displacement_m"].get<double>(), 0.0) << shape.dump();
   EXPECT_EQ(n["shapes"][1]["damping_ratio"].get<double>(), n["max_damping_ratio"].get<double>());
+  // Each shape's motion over one period for ParaView: a collection of 24 frames that exist.
+  for (const auto& shape : n["shapes"]) {
+    const std::string pvd = slurp(s.dir() / "out" / shape["frames"].get<std::string>());
+    int frames = 0;
+    for (std::size_t at = pvd.find("file=\""); at != std::string::npos; at = pvd.find("file=\"", at + 1)) {
+      const std::size_t begin = at + 6, end = pvd.find('"', begin);
+      EXPECT_TRUE(fs::exists(s.dir() / "out" / pvd.substr(begin, end - begin))) << pvd.substr(begin, end - begin);
+      ++frames;
+    }
+    EXPECT_EQ(frames, 24) << shape.dump();
+  }
   std::printf(
       "coarse wheel: %zu points, %.3f -> %.3f Hz, D max %.4f; peak HB %.4e m at %.3f Hz, synthesis %+.2e, %+.2e\n",
       rows.size() - 1, n["linear_frequency_hz"].get<double>(), n["end_frequency_hz"].get<double>(),

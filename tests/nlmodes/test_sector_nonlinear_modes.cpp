@@ -8,6 +8,8 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <iostream>
+#include <limits>
+#include <memory>
 #include <numbers>
 
 #include "../common/coarse_sector.hpp"
@@ -57,6 +59,15 @@ struct Sector : testing_support::CoarseSector {
       const auto [low, high] = mesh.shroud_pairs[i * 3];
       pairs.push_back(testing_support::circumferential_pair(mesh, low, high));
     }
+  }
+  /// The cyclic FE sector with the three pairs tied by springs of 2e5 N/m in every direction
+  /// (stuck_pairs' stiffnesses, set_interface on all DOFs): the stuck tests' reference.
+  std::unique_ptr<cyclic::CyclicSector> tied() const {
+    auto out = std::make_unique<cyclic::CyclicSector>(mesh, km);
+    std::vector<cyclic::InterfaceSpring> springs;
+    for (const auto& p : pairs) springs.push_back({p.high_node, p.low_node, p.frame, Eigen::Vector3d(2e5, 2e5, 2e5)});
+    out->set_interface(springs);
+    return out;
   }
   frf::SectorLinearPart linear(int harmonics, bool residual = true) const {
     return frf::SectorLinearPart(
@@ -152,6 +163,30 @@ hbm::ContactEvaluatorOptions options(int h, int n) {
   return o;
 }
 
+/// The friction mode both energy and shape tests follow: mu = 0.3, a 2 N preload on each of the
+/// three pairs, H = 2, N = 64, from a modal amplitude of 1e-7 to 1e-3 (stick, slip, lift-off).
+struct FrictionMode {
+  static constexpr int kHarmonics = 2;
+  frf::SectorLinearPart part;
+  hbm::ContactEvaluator ev;
+  NonlinearModeCurve curve;
+  static std::vector<contact::PairParameters> pairs() {
+    std::vector<contact::PairParameters> out = stuck_pairs();
+    for (auto& p : out) p.friction_coefficient = 0.3, p.normal_preload = 2.0;
+    return out;
+  }
+  static NonlinearModeSettings settings() {
+    NonlinearModeSettings s;
+    s.amplitude_start = 1e-7;
+    s.amplitude_end = 1e-3;
+    return s;
+  }
+  explicit FrictionMode(const Sector& f)
+      : part(f.linear(kHarmonics)),
+        ev(options(kHarmonics, 64), pairs()),
+        curve(trace_nonlinear_mode(part, ev, settings())) {}
+};
+
 TEST(SectorNonlinearModes, StuckModeIsTheSectorsModeWithTheContactSprings) {
   // Independent: the modes of the sector with the three pairs tied by springs in the cyclic
   // FE model itself (cyclic::CyclicSector::set_interface, all DOFs), against the EPMC of the
@@ -159,13 +194,10 @@ TEST(SectorNonlinearModes, StuckModeIsTheSectorsModeWithTheContactSprings) {
   const Sector& f = sector();
   const frf::SectorLinearPart part = f.linear(2);
   hbm::ContactEvaluator ev(options(2, 16), stuck_pairs());
-  cyclic::CyclicSector tied(f.mesh, f.km);
-  std::vector<cyclic::InterfaceSpring> springs;
-  for (const auto& p : f.pairs) springs.push_back({p.high_node, p.low_node, p.frame, Eigen::Vector3d(2e5, 2e5, 2e5)});
-  tied.set_interface(springs);
+  const std::unique_ptr<cyclic::CyclicSector> tied = f.tied();
   modal::ModalOptions mo;
   mo.modes = 4;
-  const modal::ModalBasis exact = modal::solve_harmonic(tied, 1, mo).basis;
+  const modal::ModalBasis exact = modal::solve_harmonic(*tied, 1, mo).basis;
   for (int mode : {1, 2}) {
     NonlinearModeSettings s;
     s.mode = mode;
@@ -182,35 +214,89 @@ TEST(SectorNonlinearModes, StuckModeIsTheSectorsModeWithTheContactSprings) {
   }
 }
 
-TEST(SectorStability, StuckContactsGiveTheDampedModesOfTheTiedSector) {
-  // With stuck contacts the exponents are those of the tied sector's damped modes. A mode of
-  // harmonic index h_1 lives in the blocks k = +-1; its copies shifted by k w would lie in
-  // blocks of other indices and do not exist, so its exponent is -zeta/2 +- i (w_j - w), once.
-  // Without the modes of index 0 (block 0 massless) the "imaginary" selection keeps it; the
-  // pipeline does not analyse sectors yet (the centroid selection would not judge it).
+TEST(SectorStability, StuckContactsGiveTheDampedModesOfTheTiedSectorInEveryFamily) {
+  // With stuck contacts the exponents of perturbation family p are the damped modes of the tied
+  // sector's harmonic index p: lambda = -zeta_j / 2 +- i w_j on block 0, once (their copies
+  // shifted by i k w belong to family p + k m). Independent references: the frequencies of the
+  // cyclic FE sector with the three pairs tied by springs (set_interface, all DOFs), and the
+  // decay phi^H C phi / 2 of the tied mode of the modal form itself (8 modes, residual
+  // flexibility condensed). With the modes of indices 0..Nb/2 every family is analysed; with
+  // those of the harmonic balance's h_n only (1 and 2 here, engine order 1), none is complete.
   const Sector& f = sector();
-  const int harmonics = 2;
-  std::map<int, modal::ModalBasis> no_index_0 = f.bases;
-  no_index_0.erase(0);
-  const frf::SectorLinearPart part(
-      *f.sector, no_index_0, [&](int h) { return f.factors.at(h); }, f.pairs,
-      testing_support::test_forcing(f.mesh, true), harmonics);
+  const int harmonics = 2, nb = f.sector->sectors();
+  std::map<int, modal::ModalBasis> bases;
+  std::map<int, modal::StiffnessFactor> factors;
+  modal::ModalOptions mo;
+  mo.modes = 8;
+  for (int h = 0; h <= nb / 2; ++h) {
+    auto r = modal::solve_harmonic(*f.sector, h, mo);
+    bases[h] = r.basis;
+    factors[h] = r.stiffness.valid() ? r.stiffness : modal::factor_harmonic_stiffness(*f.sector, h);
+  }
+  auto part_with = [&](const std::map<int, modal::ModalBasis>& b) {
+    return frf::SectorLinearPart(
+        *f.sector, b, [&](int h) { return factors.at(h); }, f.pairs, testing_support::test_forcing(f.mesh, true),
+        harmonics);
+  };
   hbm::ContactEvaluator ev(options(harmonics, 16), stuck_pairs());
-  const double hz = 0.6 * f.bases.at(1).omega[0] / (2 * kPi), omega = 2 * kPi * hz;
+  const double hz = 0.6 * bases.at(1).omega[0] / (2 * kPi), omega = 2 * kPi * hz;
+  {
+    std::map<int, modal::ModalBasis> forced_only = {{1, bases.at(1)}, {2, bases.at(2)}};
+    const frf::SectorLinearPart part = part_with(forced_only);
+    ReducedEquations eq(part, ev);
+    const FloquetResult r = floquet_exponents(eq, eq.stuck_solution(hz), hz);
+    EXPECT_FALSE(r.available);
+    EXPECT_NE(r.reason.find("index 0"), std::string::npos) << r.reason;
+  }
+  const frf::SectorLinearPart part = part_with(bases);
   ReducedEquations eq(part, ev);
-  const Eigen::VectorXd w = eq.stuck_solution(hz);
-  EXPECT_FALSE(floquet_exponents(eq, w, hz).available);
-  const FloquetResult r = floquet_exponents(eq, w, hz, ExponentSelection::symmetry, kMaxHillSize, true);
+  const Eigen::VectorXd stuck = eq.stuck_solution(hz);
+  // Every mode kept (mode_cutoff 0): the exponents are the tied modes'. With the default cutoff
+  // (kModeCutoff (H + 1) w = 3.6 w_1 here) the modes above it enter frozen at s = i k w, exact
+  // at lambda = 0 only: the exponents of the modes kept move by kFrozenModes at most.
+  const FloquetResult r = floquet_exponents(eq, stuck, hz, ExponentSelection::symmetry, kMaxHillSize, 0.0);
+  const FloquetResult cut = floquet_exponents(eq, stuck, hz);
   ASSERT_TRUE(r.available) << r.reason;
-  EXPECT_EQ(r.selection, ExponentSelection::imaginary);
+  ASSERT_TRUE(cut.available) << cut.reason;
+  ASSERT_EQ(r.families.size(), static_cast<std::size_t>(nb / 2 + 1));
   EXPECT_TRUE(r.stable);
-  for (int mode : {1, 2}) {
-    const LinearMode m = linear_mode(part, ev, mode);
-    bool found = false;
-    for (const auto& e : r.exponents)
-      found = found || (std::abs(std::abs(e.imag()) - std::abs(m.omega - omega)) <= kStuckExponent * m.omega &&
-                        std::abs(e.real() + m.zeta / 2) <= kStuckExponent * m.omega);
-    EXPECT_TRUE(found) << "mode " << mode << " at " << m.omega << " rad/s, zeta " << m.zeta << ", w " << omega;
+  EXPECT_TRUE(cut.stable);
+  const std::unique_ptr<cyclic::CyclicSector> tied = f.tied();
+  modal::ModalOptions four;
+  four.modes = 4;
+  for (int p = 0; p <= nb / 2; ++p) {
+    const modal::ModalBasis exact = modal::solve_harmonic(*tied, p, four).basis;
+    // The modal form's own tied modes: K + P^H K_c (I + R K_c)^-1 P with K_c = 2e5 I.
+    frf::SecondOrderForm so;
+    ASSERT_TRUE(part.perturbation_form(p, 0, omega, 0.0, so));
+    const Eigen::Index c = so.P.rows();
+    const Eigen::MatrixXcd kc = 2e5 * Eigen::MatrixXcd::Identity(c, c);
+    const Eigen::MatrixXcd stiff =
+        so.K.cast<Complex>() +
+        so.P.adjoint() * kc * (Eigen::MatrixXcd::Identity(c, c) + so.R * kc).partialPivLu().solve(so.P);
+    const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> tied_modal(stiff);
+    for (int mode = 0; mode < 2; ++mode) {
+      const double wj = exact.omega[mode];
+      // The modal form's mode nearest the FE one: its decay phi^H C phi / 2 (phi^H phi = 1).
+      Eigen::Index best = 0;
+      for (Eigen::Index j = 1; j < tied_modal.eigenvalues().size(); ++j)
+        if (std::abs(std::sqrt(tied_modal.eigenvalues()[j]).real() - wj) <
+            std::abs(std::sqrt(tied_modal.eigenvalues()[best]).real() - wj))
+          best = j;
+      const Eigen::VectorXcd phi = tied_modal.eigenvectors().col(best).normalized();
+      const double decay = (phi.adjoint() * so.C.cast<Complex>() * phi)(0, 0).real() / 2;
+      bool found = false;
+      for (std::size_t e = 0; e < r.exponents.size(); ++e)
+        found = found ||
+                (r.exponent_family[e] == p && std::abs(std::abs(r.exponents[e].imag()) - wj) <= kTruncation * wj &&
+                 std::abs(r.exponents[e].real() + decay) <= kStuckExponent * wj);
+      double nearest = std::numeric_limits<double>::infinity();
+      for (std::size_t e = 0; e < cut.exponents.size(); ++e)
+        if (cut.exponent_family[e] == p && cut.exponents[e].imag() > 0)
+          nearest = std::min(nearest, std::abs(cut.exponents[e] - Complex(-decay, wj)) / wj);
+      std::printf("index %d mode %d: %.6g rad/s, with the cutoff %.2e\n", p, mode + 1, wj, nearest);
+      EXPECT_TRUE(found) << "index " << p << ", mode " << mode + 1 << " at " << wj << " rad/s, decay " << decay;
+    }
   }
 }
 
@@ -220,17 +306,12 @@ TEST(SectorNonlinearModes, FrictionModeBalancesItsEnergyPerCycle) {
   // with the modal motions eta_n = -diag(1/den) psi_c^H F_n recomputed here from the modes
   // (psi_c = B T phi) and the solution's contact forces; the residual part is massless.
   const Sector& f = sector();
-  const int harmonics = 2;
-  const frf::SectorLinearPart part = f.linear(harmonics);
-  std::vector<contact::PairParameters> pairs = stuck_pairs();
-  for (auto& p : pairs) p.friction_coefficient = 0.3, p.normal_preload = 2.0;
-  hbm::ContactEvaluator ev(options(harmonics, 64), pairs);
-  NonlinearModeSettings s;
-  s.amplitude_start = 1e-7;
-  s.amplitude_end = 1e-3;
-  const NonlinearModeCurve curve = trace_nonlinear_mode(part, ev, s);
+  const int harmonics = FrictionMode::kHarmonics;
+  FrictionMode mode(f);
+  const NonlinearModeCurve& curve = mode.curve;
   ASSERT_TRUE(curve.reached_end) << curve.message;
-  NonlinearModeEquations eq(part, ev);
+  hbm::ContactEvaluator& ev = mode.ev;
+  NonlinearModeEquations eq(mode.part, ev);
   double worst = 0.0, d_max = 0.0;
   for (const auto& p : curve.points) {
     Eigen::VectorXd force;
@@ -267,17 +348,12 @@ TEST(SectorNonlinearModes, ModeShapesCarryTheModesContactMotion) {
   // The shapes nlmodes writes (frf::sector_displacements without excitation, with -zeta M):
   // their contact rows B_h U_n are the solution's contact motion W_n, at every point kind.
   const Sector& f = sector();
-  const int harmonics = 2;
-  const frf::SectorLinearPart part = f.linear(harmonics);
-  std::vector<contact::PairParameters> pairs = stuck_pairs();
-  for (auto& p : pairs) p.friction_coefficient = 0.3, p.normal_preload = 2.0;
-  hbm::ContactEvaluator ev(options(harmonics, 64), pairs);
-  NonlinearModeSettings s;
-  s.amplitude_start = 1e-7;
-  s.amplitude_end = 1e-3;
-  const NonlinearModeCurve curve = trace_nonlinear_mode(part, ev, s);
+  const int harmonics = FrictionMode::kHarmonics;
+  FrictionMode mode(f);
+  const NonlinearModeCurve& curve = mode.curve;
   ASSERT_TRUE(curve.reached_end) << curve.message;
-  NonlinearModeEquations eq(part, ev);
+  hbm::ContactEvaluator& ev = mode.ev;
+  NonlinearModeEquations eq(mode.part, ev);
   std::vector<frf::ShapeLoad> loads;
   const std::vector<std::size_t> at = {0, curve.points.size() / 2, curve.points.size() - 1};
   for (std::size_t i : at) {
