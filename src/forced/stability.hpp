@@ -15,8 +15,10 @@
 //   (mu^2 A2 + mu A1 + A0) q = 0,   A2 = M_k,  A1 = (C_k + 2 i k w M_k) / w,
 //   A0 = (K_k + i k w C_k - k^2 w^2 M_k + P_k^H [E P q]_k) / w^2   (blocks over k),
 // solved as a linear eigenproblem of twice the size (companion form). Its 2 m (2H + 1)
-// eigenvalues hold each Floquet exponent 2H + 1 times, shifted by i k w; the truncation spoils
-// the copies whose eigenvectors crowd the outer harmonics. Selection:
+// eigenvalues hold each Floquet exponent 2H + 1 times, shifted by i k w, when D is
+// block-Toeplitz (a memoryless law: the gap, a cubic spring); the truncation spoils the copies
+// whose eigenvectors crowd the outer harmonics. The friction slider's memory makes D depend on
+// more than k - l (its stick runs' anchors), and the copies are no longer exact. Selection:
 //   symmetry  (default) the exponents whose eigenvector's harmonic centroid
 //             sum_k k q_k^H M_k q_k / sum_k q_k^H M_k q_k (mass-weighted: the same in any
 //             coordinates) lies within half a harmonic of 0;
