@@ -285,7 +285,6 @@ std::vector<StabilityChange> stability_changes(const std::vector<FloquetResult>&
     const double im = std::abs(unstable.exponents.front().imag()) / w;
     StabilityChange c;
     c.point = i;
-    c.family = unstable.exponent_family.empty() ? 0 : unstable.exponent_family.front();
     c.kind = im < kKindTolerance                   ? StabilityChange::Kind::fold
              : std::abs(im - 0.5) < kKindTolerance ? StabilityChange::Kind::period_doubling
                                                    : StabilityChange::Kind::neimark_sacker;

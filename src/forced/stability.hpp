@@ -101,8 +101,7 @@ FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::Harmon
 struct StabilityChange {
   enum class Kind { fold, period_doubling, neimark_sacker };
   Kind kind = Kind::fold;
-  std::size_t point = 0;  ///< the change lies between point and point + 1
-  int family = 0;         ///< the perturbation family of the critical exponent (FE sector: its harmonic index)
+  std::size_t point = 0;                         ///< the change lies between point and point + 1
   double frequency_hz = 0.0, amplitude_m = 0.0;  ///< linear interpolation where max_real crosses 0
 };
 std::string to_string(StabilityChange::Kind kind);

@@ -28,9 +28,6 @@ namespace shroudsim::frf {
 struct SecondOrderForm {
   Eigen::MatrixXd M, C, K;
   Eigen::MatrixXcd P, R;
-  /// Each harmonic in its own coordinates (an FE sector: harmonic n in harmonic index n m mod
-  /// Nb): the Hill problem then has no exponent copies shifted by i k w (forced/stability.hpp).
-  bool own_coordinates_per_harmonic = false;
 };
 
 /// The receptances of the autonomous system of the extended periodic motion concept

@@ -202,7 +202,6 @@ std::vector<double> SectorLinearPart::resonances_hz() const {
 
 bool SectorLinearPart::second_order_form(int n, SecondOrderForm& out) const {
   const int c = n_contact();
-  out.own_coordinates_per_harmonic = true;
   if (n == 0) {
     const Eigen::Index m = static_.omega.size();
     out.M = Eigen::MatrixXd::Identity(m, m);

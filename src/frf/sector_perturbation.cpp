@@ -40,7 +40,6 @@ bool SectorLinearPart::perturbation_form(int family, int k, double w, double max
   const IndexData* d = index_data(g, conjugate);
   if (d == nullptr) return false;
   const int c = n_contact();
-  out.own_coordinates_per_harmonic = true;
   auto psi = [&](Eigen::Index r) -> Eigen::VectorXcd {
     return conjugate ? Eigen::VectorXcd(d->psi.col(r).head(c).conjugate()) : Eigen::VectorXcd(d->psi.col(r).head(c));
   };

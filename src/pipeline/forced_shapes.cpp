@@ -74,6 +74,17 @@ std::vector<std::vector<int>> pair_nodes(const std::vector<frf::SectorContactPai
   return nodes;
 }
 
+std::string pvd(const std::vector<std::string>& files) {
+  std::ostringstream s;
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+       "  <Collection>\n";
+  for (std::size_t k = 0; k < files.size(); ++k)
+    s << "    <DataSet timestep=\"" << static_cast<double>(k) / files.size() << "\" part=\"0\" file=\"" << files[k]
+      << "\"/>\n";
+  s << "  </Collection>\n</VTKFile>\n";
+  return s.str();
+}
+
 void write_sector_files(Context& ctx, const forced::ForcedModel& model, const std::vector<Shape>& shapes,
                         const std::vector<std::vector<Eigen::VectorXcd>>& forces,
                         const std::vector<std::vector<forced::PairState>>& states, std::size_t largest,
@@ -142,19 +153,6 @@ SectorShapes sector_shapes(const Context& ctx, const forced::ForcedModel& model,
   out.mesh = modal.mesh;
   return out;
 }
-
-namespace {
-std::string pvd(const std::vector<std::string>& files) {
-  std::ostringstream s;
-  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-       "  <Collection>\n";
-  for (std::size_t k = 0; k < files.size(); ++k)
-    s << "    <DataSet timestep=\"" << static_cast<double>(k) / files.size() << "\" part=\"0\" file=\"" << files[k]
-      << "\"/>\n";
-  s << "  </Collection>\n</VTKFile>\n";
-  return s.str();
-}
-}  // namespace
 
 ShapeFiles write_shape(const std::filesystem::path& out_dir, const mesh::Mesh& mesh,
                        const std::vector<Eigen::VectorXcd>& u, const std::string& name, const std::string& frames_dir,

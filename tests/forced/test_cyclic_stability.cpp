@@ -185,7 +185,6 @@ class CyclicChain : public frf::LinearPart {
   int wrap(int g) const { return (g % sectors_ + sectors_) % sectors_; }
   void block_form(int g, frf::SecondOrderForm& out) const {
     const Eigen::MatrixXd k = stiffness(g);
-    out.own_coordinates_per_harmonic = true;
     out.R = Eigen::MatrixXcd::Zero(3, 3);
     if (coordinates_ == Coordinates::physical) {
       out.M = mass();
