@@ -6,7 +6,8 @@
 namespace shroudsim::frf {
 
 void LinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const {
-  const double h = 1e-6 * std::max(std::abs(w), 1.0);
+  // Relative to w, whatever its unit (a floor in rad/s would be a coarse step at 0.01 Hz).
+  const double h = w != 0.0 ? 1e-6 * std::abs(w) : 1e-6;
   HarmonicReceptance plus, minus;
   harmonic(n, w + h, plus);
   harmonic(n, w - h, minus);

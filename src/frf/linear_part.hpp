@@ -67,7 +67,8 @@ class LinearPart {
   virtual void harmonic(int n, double w, HarmonicReceptance& out) const = 0;
   /// d/dw of G_n(n w) and of w_lin,n(n w), with respect to the fundamental circular
   /// frequency w [rad/s] (units m/N/(rad/s) and m/(rad/s)). The default is a central
-  /// difference of harmonic() (step 1e-6 w); models with a modal form override it exactly.
+  /// difference of harmonic() (step 1e-6 w, relative); the lumped and the modal (sector)
+  /// models override it exactly.
   virtual void harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const;
   /// Work of the excitation per fundamental period [J] and viscous dissipation per period
   /// [J], given the complex contact forces F_n (n = 0..H, each of size c) at frequency w.

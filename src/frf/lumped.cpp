@@ -61,6 +61,25 @@ void LumpedLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const 
   out.u_lin = rf.segment(response_dof_, 1);
 }
 
+void LumpedLinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const {
+  using Complex = std::complex<double>;
+  const double big_w = n * w;
+  const Eigen::MatrixXcd dyn =
+      k_.cast<Complex>() - big_w * big_w * m_.cast<Complex>() + Complex(0.0, big_w) * c_.cast<Complex>();
+  // X = D^-1 [B^T f],  dX/dw = -D^-1 (dD/dw) X,  dD/dw = -2 n^2 w M + i n C.
+  const Eigen::MatrixXcd d_dw = -2.0 * n * big_w * m_.cast<Complex>() + Complex(0.0, n) * c_.cast<Complex>();
+  const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(dyn);
+  Eigen::MatrixXcd rhs(m_.rows(), b_.rows() + 1);
+  rhs.leftCols(b_.rows()) = b_.transpose().cast<Complex>();
+  rhs.col(b_.rows()).setZero();
+  if (n == 1) rhs(excited_dof_, b_.rows()) = force_;
+  const Eigen::MatrixXcd x = lu.solve(rhs);
+  const Eigen::MatrixXcd dx = -lu.solve(d_dw * x);
+  const Eigen::MatrixXcd bdx = b_.cast<Complex>() * dx;
+  dG = bdx.leftCols(b_.rows());
+  dw_lin = bdx.col(b_.rows());
+}
+
 bool LumpedLinearPart::damped_harmonic(int n, double w, double zeta, bool with_norm, DampedReceptance& out) const {
   using Complex = std::complex<double>;
   const double big_w = n * w;

@@ -28,6 +28,8 @@ class LumpedLinearPart : public LinearPart {
   int n_contact() const override { return 3 * static_cast<int>(contacts_.size()); }
   int n_response() const override { return 1; }
   void harmonic(int n, double w, HarmonicReceptance& out) const override;
+  /// Exact: dX/dw = -D^-1 (-2 n^2 w M + i n C) X with D = K - (n w)^2 M + i n w C.
+  void harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const override;
   void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
               double& viscous_dissipation) const override;
   std::string describe() const override;

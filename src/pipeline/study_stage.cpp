@@ -32,6 +32,7 @@ struct StudyPoint {
   double peak = 0.0, peak_frequency = 0.0, seconds = 0.0;
   double cpu_seconds = 0.0;  ///< CPU time of the point's own thread (points run with threads = 1)
   std::size_t points = 0;
+  int harmonics = 0, time_samples = 0;  ///< of the curve reported (a raised N or a search may differ from the case's)
 };
 
 std::string folder_name(const std::vector<std::pair<std::string, std::string>>& values) {
@@ -103,12 +104,16 @@ distributed::Json run_point(const distributed::Json& task, const Runners& runner
                          {"rank", distributed::world().rank()},
                          {"peak", 0.0},
                          {"peak_frequency", 0.0},
-                         {"points", 0}};
+                         {"points", 0},
+                         {"harmonics", 0},
+                         {"time_samples", 0}};
   const auto& j = pc.report.json();
   if (j.contains("frf")) {
     r["peak"] = j["frf"].value("peak_amplitude_m", 0.0);
     r["peak_frequency"] = j["frf"].value("peak_frequency_hz", 0.0);
     r["points"] = j["frf"].value("points", std::size_t{0});
+    r["harmonics"] = j["frf"].value("harmonics", 0);
+    r["time_samples"] = j["frf"].value("time_samples", 0);
   }
   nlohmann::json rj = j;
   rj["status"] = status == 0 ? "ok" : "failed";
@@ -150,6 +155,8 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
             p.peak = j["frf"].value("peak_amplitude_m", 0.0);
             p.peak_frequency = j["frf"].value("peak_frequency_hz", 0.0);
             p.points = j["frf"].value("points", std::size_t{0});
+            p.harmonics = j["frf"].value("harmonics", 0);
+            p.time_samples = j["frf"].value("time_samples", 0);
           }
           p.seconds = j.value("point_seconds", 0.0);
           p.cpu_seconds = j.value("point_cpu_seconds", 0.0);
@@ -190,6 +197,8 @@ int run_points(Context& ctx, const std::vector<io::Case>& cases, std::vector<Stu
         p.peak = r.at("peak").get<double>();
         p.peak_frequency = r.at("peak_frequency").get<double>();
         p.points = r.at("points").get<std::size_t>();
+        p.harmonics = r.value("harmonics", 0);
+        p.time_samples = r.value("time_samples", 0);
         if (!verbose) return;
         std::ostringstream s;
         s << "shroudsim: study: " << p.folder << ": " << (p.status == 0 ? "ok" : "failed (" + p.message + ")")
@@ -276,7 +285,7 @@ StudyOutcome run_convergence(Context& ctx, const Runners& runners) {
 
   std::ostringstream csv;
   csv << "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,peaks_error,"
-         "peak_frequency_error_hz,folder,cpu_seconds\n";
+         "peak_frequency_error_hz,folder,cpu_seconds,harmonics,time_samples\n";
   int failed = 0;
   for (const auto& row : rows) {
     const StudyPoint& p = points[row.point];
@@ -294,7 +303,7 @@ StudyOutcome run_convergence(Context& ctx, const Runners& runners) {
     csv << knobs[row.knob].name << "," << knobs[row.knob].key << "," << value << "," << ref << ","
         << (p.status == 0 ? "ok" : "failed") << "," << num(p.seconds) << "," << p.points << "," << num(p.peak) << ","
         << num(p.peak_frequency) << "," << (ok ? num(err) : "") << "," << (ok ? num(ferr) : "") << "," << p.folder
-        << "," << num(p.cpu_seconds) << "\n";
+        << "," << num(p.cpu_seconds) << "," << p.harmonics << "," << p.time_samples << "\n";
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "trade.csv", csv.str());
@@ -417,7 +426,7 @@ StudyOutcome run_sampled(Context& ctx, const Runners& runners) {
   std::ostringstream csv;
   csv << "sample";
   for (const auto& in : st.sample) csv << "," << in.key;
-  csv << ",status,peak_amplitude_m,peak_frequency_hz,points,seconds,folder,message\n";
+  csv << ",status,peak_amplitude_m,peak_frequency_hz,points,seconds,folder,message,harmonics,time_samples\n";
   int failed = 0;
   std::vector<double> peaks, freqs;
   std::vector<std::vector<double>> inputs(static_cast<std::size_t>(dims));
@@ -428,7 +437,7 @@ StudyOutcome run_sampled(Context& ctx, const Runners& runners) {
     const bool ok = p.status == 0;
     csv << "," << (ok ? "ok" : "failed") << "," << io::format_number(p.peak) << ","
         << io::format_number(p.peak_frequency) << "," << p.points << "," << io::format_number(p.seconds) << ","
-        << p.folder << "," << csv_field(p.message) << "\n";
+        << p.folder << "," << csv_field(p.message) << "," << p.harmonics << "," << p.time_samples << "\n";
     failed += !ok;
     if (!ok) continue;
     peaks.push_back(p.peak);
@@ -545,7 +554,7 @@ StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunne
 
   std::ostringstream csv;
   for (const auto& [k, v] : points.front().values) csv << k << ",";
-  csv << "status,peak_amplitude_m,peak_frequency_hz,points,seconds,folder\n";
+  csv << "status,peak_amplitude_m,peak_frequency_hz,points,seconds,folder,harmonics,time_samples\n";
   int failed = 0;
   for (const auto& p : points) {
     for (const auto& [k, v] : p.values) {
@@ -555,7 +564,7 @@ StudyOutcome run_study(Context& ctx, const CaseRunner& run_case, const CaseRunne
     }
     csv << (p.status == 0 ? "ok" : "failed") << "," << io::format_number(p.peak) << ","
         << io::format_number(p.peak_frequency) << "," << p.points << "," << io::format_number(p.seconds) << ","
-        << p.folder << "\n";
+        << p.folder << "," << p.harmonics << "," << p.time_samples << "\n";
     failed += p.status != 0;
   }
   io::write_file_atomic(ctx.out_dir / "study.csv", csv.str());

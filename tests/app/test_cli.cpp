@@ -264,15 +264,23 @@ TEST(Cli, ConvergenceStudyTabulatesEveryKnobAgainstItsFinestValue) {
   ASSERT_GT(lines.size(), 1u);
   EXPECT_EQ(lines[0],
             "knob,key,value,reference_value,status,seconds,points,peak_amplitude_m,peak_frequency_hz,"
-            "peaks_error,peak_frequency_error_hz,folder,cpu_seconds");
+            "peaks_error,peak_frequency_error_hz,folder,cpu_seconds,harmonics,time_samples");
   // Rows per knob, in the order coarse to fine: (value, error).
   std::map<std::string, std::vector<std::pair<std::string, double>>> knobs;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     std::vector<std::string> f;
     std::istringstream row(lines[i]);
     for (std::string x; std::getline(row, x, ',');) f.push_back(x);
-    ASSERT_EQ(f.size(), 13u) << lines[i];
+    ASSERT_EQ(f.size(), 15u) << lines[i];
     EXPECT_EQ(f[4], "ok") << lines[i];
+    // The discretization each row's curve was traced with: the knob's value (a curve may be
+    // traced again with a finer N when its energy check fails, never with a coarser one).
+    if (f[1] == "hbm.harmonics") {
+      EXPECT_EQ(std::stoi(f[13]), std::stoi(f[2])) << lines[i];  // the value: "H" or "H hbm.time_samples=N"
+    }
+    if (f[1] == "hbm.time_samples") {
+      EXPECT_GE(std::stoi(f[14]), std::stoi(f[2])) << lines[i];
+    }
     knobs[f[1]].emplace_back(f[2], std::stod(f[9]));
     if (f[2] == f[3]) {
       EXPECT_EQ(std::stod(f[9]), 0.0) << "a reference has no error against itself: " << lines[i];
@@ -365,6 +373,9 @@ TEST(Cli, StudyRunsEveryPointInItsOwnFolder) {
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_EQ(lines[0].rfind("contact.friction_coefficient,contact.normal_preload,status,peak_amplitude_m", 0), 0u)
       << lines[0];
+  // Each row ends with the H and N its curve was traced with (the case's 3 and 64 here).
+  EXPECT_EQ(lines[0].substr(lines[0].size() - 30), ",folder,harmonics,time_samples") << lines[0];
+  for (std::size_t i = 1; i < lines.size(); ++i) EXPECT_EQ(lines[i].substr(lines[i].size() - 5), ",3,64") << lines[i];
   EXPECT_TRUE(fs::exists(s.dir() / "results" / "jenkins" / "friction_coefficient=0.3__normal_preload=0.5" / "frf.csv"));
   // A higher preload sticks more: the 2 N point's peak is lower than the 0.5 N one.
   auto peak = [&](const std::string& line) { return std::stod(line.substr(line.find(",ok,") + 4)); };

@@ -1,6 +1,7 @@
 // Forced response of lumped models against independent closed forms.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <numbers>
 
@@ -195,6 +196,60 @@ TEST(ForcedLumped, FiniteDifferenceJacobianGivesTheSameCurve) {
   for (const auto& p : f.points) {
     eq1->evaluate(p.x, p.lambda, r, nullptr, nullptr);
     EXPECT_LT(r.lpNorm<Eigen::Infinity>(), 1e-9) << p.lambda;
+  }
+}
+
+TEST(ForcedLumped, ExactFrequencyDerivativeOfTheReceptanceAtEveryTimeScale) {
+  // A 2-DOF chain (zeta 1e-3 at its first mode), one quasi3d contact acting between the DOFs,
+  // rescaled in time by s (M -> s^2 M, C -> s C: frequencies / s). At w near the first
+  // resonance the receptance turns over a width zeta w, so a difference step must be relative.
+  // G(w / s) of the rescaled model equals G(w) of the original, hence dG/dw scales by s.
+  const Eigen::Matrix2d m{{1.0, 0.0}, {0.0, 2.0}}, k{{2.0, -1.0}, {-1.0, 1.5}};
+  frf::LumpedContact e;
+  e.dof = {0, 1, -1};
+  e.other = {1, -1, -1};
+  e.frame_angle = 0.3;
+  const double w1 = std::sqrt(
+      Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d>(k, m, Eigen::EigenvaluesOnly).eigenvalues()[0]);
+  const Eigen::Matrix2d c = (2 * 1e-3 / w1) * k;
+  Eigen::MatrixXcd dg1;
+  Eigen::VectorXcd dw1;
+  for (double s : {1.0, 1e-3, 1e3}) {
+    const frf::LumpedLinearPart part(s * s * m, k, s * c, {e}, 0, 1.0, 1);
+    const double w = 1.0003 * w1 / s;
+    for (int n : {1, 2}) {
+      Eigen::MatrixXcd dg;
+      Eigen::VectorXcd dw;
+      part.harmonic_derivative(n, w, dg, dw);
+      // Richardson-extrapolated central differences with a step of 1e-3 of the width.
+      const double h = 1e-6 * w;
+      auto central = [&](double step, Eigen::MatrixXcd& g, Eigen::VectorXcd& l) {
+        frf::HarmonicReceptance plus, minus;
+        part.harmonic(n, w + step, plus);
+        part.harmonic(n, w - step, minus);
+        g = (plus.G - minus.G) / (2 * step);
+        l = (plus.w_lin - minus.w_lin) / (2 * step);
+      };
+      Eigen::MatrixXcd g_h, g_2h;
+      Eigen::VectorXcd l_h, l_2h;
+      central(h, g_h, l_h);
+      central(2 * h, g_2h, l_2h);
+      const Eigen::MatrixXcd g_fd = (4 * g_h - g_2h) / 3;
+      const Eigen::VectorXcd l_fd = (4 * l_h - l_2h) / 3;
+      constexpr double kDifferenceError = 1e-7;  // round-off of G / h at h = 1e-6 w, and O(h^4)
+      EXPECT_LE((dg - g_fd).norm(), kDifferenceError * dg.norm()) << "s " << s << ", n " << n;
+      if (n == 1) {
+        EXPECT_LE((dw - l_fd).norm(), kDifferenceError * dw.norm()) << "s " << s;
+        if (s == 1.0) {
+          dg1 = dg, dw1 = dw;
+        } else {
+          // Exact arithmetic gives s dG_1 exactly; the products differ in round-off only.
+          constexpr double kRescaled = 1e-12;
+          EXPECT_LE((dg - s * dg1).norm(), kRescaled * dg.norm()) << "s " << s;
+          EXPECT_LE((dw - s * dw1).norm(), kRescaled * dw.norm()) << "s " << s;
+        }
+      }
+    }
   }
 }
 

@@ -16,7 +16,8 @@ def plot_sampled(result_dir, rows):
 
     import matplotlib.pyplot as plt
 
-    fixed = ["sample", "status", "peak_amplitude_m", "peak_frequency_hz", "points", "seconds", "folder", "message"]
+    fixed = ["sample", "status", "peak_amplitude_m", "peak_frequency_hz", "points", "seconds", "folder", "message",
+             "harmonics", "time_samples"]
     inputs = [k for k in rows[0] if k not in fixed]
     ok = [r for r in rows if r["status"] == "ok"]
     if not ok:
@@ -70,7 +71,8 @@ def plot_study(result_dir):
     if next(iter(rows[0])) == "sample":
         plot_sampled(result_dir, rows)
         return
-    fixed = ["status", "peak_amplitude_m", "peak_frequency_hz", "points", "seconds", "folder"]
+    fixed = ["status", "peak_amplitude_m", "peak_frequency_hz", "points", "seconds", "folder", "harmonics",
+             "time_samples"]
     keys = [k for k in rows[0] if k not in fixed]
     first, others = keys[0], keys[1:]
 
