@@ -5,8 +5,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
+#include <mutex>
 
 #include "continuation/events.hpp"
 #include "core/error.hpp"
@@ -251,6 +253,12 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
 constexpr int kPatientNewtonIterations = 100;
 constexpr int kFinerTimeSamples = 1024;
 
+// The time integration's output: 4096 samples per period whatever the harmonic balance's N (the
+// steps per period are a multiple of it, and at least 4096 anyway; a finer N takes its own), so
+// that the attempts with a raised N (pipeline, hbm.raise_time_samples: N, 4 N, 16 N up to
+// 4096) and the points of a convergence study in N march once, not once each.
+constexpr int kMarchOutputSamples = 4096;
+
 bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
                            ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
                            Eigen::VectorXd& x, std::string& how, std::string& why, bool& not_periodic,
@@ -260,9 +268,11 @@ bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluator
   const LumpedSystem system{lumped->mass(), lumped->damping(), lumped->stiffness(), lumped->contact_operator(),
                             lumped->force_vector()};
   TimeMarchOptions to;
-  to.output_samples = eo.n_time_samples;
+  to.output_samples = std::max(eo.n_time_samples, kMarchOutputSamples);
+  bool reused = false;
   say(info, "frf: no harmonic-balance start at " + shortest(f) + " Hz; integrating the equations of motion in time");
-  const TimeMarchResult tm = march_to_steady_state(system, model.pairs, eo.law.model, f, to);
+  const TimeMarchResult tm = march_to_steady_state_cached(system, model.pairs, eo.law.model, f, to, &reused);
+  if (reused) say(info, "frf: (the time integration at " + shortest(f) + " Hz of an earlier attempt, reused)");
   const std::string what = "the motion at " + shortest(f) + " Hz is " + tm.describe();
   // A motion that still changes by up to a percent from period to period may be periodic to
   // the scheme's resolution of its stick-slip and impact instants (a step quantizes them): it

@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <mutex>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "hbm/harmonic_layout.hpp"
 
@@ -258,6 +260,53 @@ TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<c
   }
   r.displacement = u;
   r.velocity = v;
+  return r;
+}
+
+TimeMarchResult march_to_steady_state_cached(const LumpedSystem& system,
+                                             const std::vector<contact::PairParameters>& pairs, contact::Model law,
+                                             double frequency_hz, const TimeMarchOptions& options, bool* reused) {
+  // The exact bytes of every input are the key.
+  std::string key;
+  auto put = [&key](const void* p, std::size_t n) { key.append(static_cast<const char*>(p), n); };
+  auto put_matrix = [&](const auto& m) {
+    const Eigen::Index r = m.rows(), c = m.cols();
+    put(&r, sizeof r);
+    put(&c, sizeof c);
+    put(m.data(), sizeof(double) * static_cast<std::size_t>(m.size()));
+  };
+  put_matrix(system.mass);
+  put_matrix(system.damping);
+  put_matrix(system.stiffness);
+  put_matrix(system.contact_operator);
+  put_matrix(system.force);
+  for (const contact::PairParameters& p : pairs) {
+    for (double v : {p.tangential_stiffness, p.normal_stiffness, p.friction_coefficient, p.normal_preload})
+      put(&v, sizeof v);
+    put(&p.preload_in_equilibrium, sizeof p.preload_in_equilibrium);
+  }
+  put(&law, sizeof law);
+  put(&frequency_hz, sizeof frequency_hz);
+  for (double v : {static_cast<double>(options.min_steps_per_period), options.steps_per_stiff_period,
+                   static_cast<double>(options.max_periods), static_cast<double>(options.max_steps),
+                   static_cast<double>(options.max_period_multiple), options.periodicity_tolerance,
+                   static_cast<double>(options.output_samples)})
+    put(&v, sizeof v);
+  static std::mutex mutex;
+  static std::deque<std::pair<std::string, TimeMarchResult>> cache;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [k, r] : cache)
+      if (k == key) {
+        if (reused) *reused = true;
+        return r;
+      }
+  }
+  if (reused) *reused = false;
+  TimeMarchResult r = march_to_steady_state(system, pairs, law, frequency_hz, options);
+  const std::lock_guard<std::mutex> lock(mutex);
+  cache.emplace_back(std::move(key), r);
+  if (cache.size() > kMarchCacheEntries) cache.pop_front();
   return r;
 }
 

@@ -66,6 +66,18 @@ struct TimeMarchResult {
 TimeMarchResult march_to_steady_state(const LumpedSystem& system, const std::vector<contact::PairParameters>& pairs,
                                       contact::Model model, double frequency_hz, const TimeMarchOptions& options);
 
+/// march_to_steady_state, remembered for the process: a call with the same inputs (every
+/// byte of system, pairs, law, frequency and options) returns the earlier result (*reused set
+/// true when given) instead of marching again (up to a minute at 20,000 periods). The start
+/// search marches where the harmonic balance finds no start, and the attempts with a raised
+/// N (hbm.raise_time_samples) ask again at the same frequencies. Thread-safe; the last
+/// kMarchCacheEntries results are kept.
+constexpr std::size_t kMarchCacheEntries = 64;
+TimeMarchResult march_to_steady_state_cached(const LumpedSystem& system,
+                                             const std::vector<contact::PairParameters>& pairs, contact::Model law,
+                                             double frequency_hz, const TimeMarchOptions& options,
+                                             bool* reused = nullptr);
+
 /// Real Fourier coefficients [c0 | c1 s1 | ... | cH sH] per row of `samples` (equally spaced
 /// over one period), in the contact evaluator's layout (pairs one after the other, each with
 /// the first `n_directions` of its rows x, y, z): the harmonic-balance unknowns W.

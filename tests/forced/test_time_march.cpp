@@ -68,6 +68,43 @@ TEST(TimeMarch, WithoutFrictionTheMotionIsTheExactLinearResponse) {
   }
 }
 
+TEST(TimeMarch, TheRememberedMarchIsTheMarchOfTheSameInputsAndOnlyOfThem) {
+  // A Jenkins element that slips: the cached call marches once, a second identical call returns
+  // the same motion without marching, and a change of any input (frequency, friction, output
+  // samples) marches anew, giving that input's own result.
+  const frf::LumpedLinearPart linear = chain();
+  std::vector<contact::PairParameters> pairs{pair(1e4, 1.0, 0.3, 0.2)};
+  TimeMarchOptions o;
+  o.output_samples = 64;
+  o.max_periods = 400;
+  const LumpedSystem sys = system_of(linear);
+  const double f_hz = 12.345678;  // a frequency no other test of this process marches at
+  bool reused = true;
+  const TimeMarchResult first = march_to_steady_state_cached(sys, pairs, contact::Model::one_d, f_hz, o, &reused);
+  EXPECT_FALSE(reused);
+  const TimeMarchResult again = march_to_steady_state_cached(sys, pairs, contact::Model::one_d, f_hz, o, &reused);
+  EXPECT_TRUE(reused);
+  EXPECT_EQ(again.periods, first.periods);
+  EXPECT_EQ(again.contact_motion, first.contact_motion);
+  // The uncached march of the same inputs is the same, bit for bit.
+  const TimeMarchResult direct = march_to_steady_state(sys, pairs, contact::Model::one_d, f_hz, o);
+  EXPECT_EQ(direct.contact_motion, first.contact_motion);
+  // Any other input: marched, and its own answer.
+  const TimeMarchResult other_f =
+      march_to_steady_state_cached(sys, pairs, contact::Model::one_d, f_hz * 1.01, o, &reused);
+  EXPECT_FALSE(reused);
+  EXPECT_NE(other_f.contact_motion, first.contact_motion);
+  pairs[0].friction_coefficient = 0.31;
+  const TimeMarchResult other_mu = march_to_steady_state_cached(sys, pairs, contact::Model::one_d, f_hz, o, &reused);
+  EXPECT_FALSE(reused);
+  EXPECT_NE(other_mu.contact_motion, first.contact_motion);
+  pairs[0].friction_coefficient = 0.3;
+  o.output_samples = 128;
+  const TimeMarchResult other_n = march_to_steady_state_cached(sys, pairs, contact::Model::one_d, f_hz, o, &reused);
+  EXPECT_FALSE(reused);
+  EXPECT_EQ(other_n.contact_motion.cols(), 128);
+}
+
 TEST(TimeMarch, AnUndampedModeAtAFractionOfTheExcitationGivesASubharmonicMotion) {
   // m u'' + k u = cos(w t) from rest: u = A (cos w t - cos w_n t), periodic over p excitation
   // periods when w_n = w / p, never periodic when w / w_n is irrational. The scheme (central
