@@ -132,7 +132,9 @@ TEST(CliMpi, AFailedPointIsRecordedAndTheOthersFinish) {
   EXPECT_EQ(rows[1][1], "failed");
   EXPECT_EQ(rows[2][1], "ok");
   EXPECT_EQ(rows[3][1], "ok");
-  const auto failed = run_json(s.dir() / "out" / rows[1].back());
+  const auto folder = std::find(rows[0].begin(), rows[0].end(), "folder") - rows[0].begin();
+  ASSERT_LT(folder, static_cast<std::ptrdiff_t>(rows[0].size()));
+  const auto failed = run_json(s.dir() / "out" / rows[1][static_cast<std::size_t>(folder)]);
   EXPECT_NE(failed.value("message", "").find("max_points"), std::string::npos) << failed.dump();
   EXPECT_EQ(run_json(s.dir() / "out")["study"]["failed"], 1);
 }
