@@ -5,10 +5,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <functional>
 #include <limits>
-#include <mutex>
 
 #include "continuation/events.hpp"
 #include "core/error.hpp"

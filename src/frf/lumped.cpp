@@ -45,10 +45,14 @@ LumpedLinearPart::LumpedLinearPart(Eigen::MatrixXd mass, Eigen::MatrixXd stiffne
   }
 }
 
+Eigen::MatrixXcd LumpedLinearPart::dynamic_matrix(double big_w) const {
+  return k_.cast<std::complex<double>>() - big_w * big_w * m_.cast<std::complex<double>>() +
+         std::complex<double>(0.0, big_w) * c_.cast<std::complex<double>>();
+}
+
 void LumpedLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const {
   const double big_w = n * w;
-  const Eigen::MatrixXcd dyn = k_.cast<std::complex<double>>() - big_w * big_w * m_.cast<std::complex<double>>() +
-                               std::complex<double>(0.0, big_w) * c_.cast<std::complex<double>>();
+  const Eigen::MatrixXcd dyn = dynamic_matrix(big_w);
   const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(dyn);
   // R B^H: one solve per contact direction; R f: one solve.
   const Eigen::MatrixXcd rbh = lu.solve(b_.transpose().cast<std::complex<double>>());
@@ -64,8 +68,7 @@ void LumpedLinearPart::harmonic(int n, double w, HarmonicReceptance& out) const 
 void LumpedLinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const {
   using Complex = std::complex<double>;
   const double big_w = n * w;
-  const Eigen::MatrixXcd dyn =
-      k_.cast<Complex>() - big_w * big_w * m_.cast<Complex>() + Complex(0.0, big_w) * c_.cast<Complex>();
+  const Eigen::MatrixXcd dyn = dynamic_matrix(big_w);
   // X = D^-1 [B^T f],  dX/dw = -D^-1 (dD/dw) X,  dD/dw = -2 n^2 w M + i n C.
   const Eigen::MatrixXcd d_dw = -2.0 * n * big_w * m_.cast<Complex>() + Complex(0.0, n) * c_.cast<Complex>();
   const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(dyn);
@@ -119,8 +122,7 @@ bool LumpedLinearPart::second_order_form(int /*n*/, SecondOrderForm& out) const 
 
 Eigen::VectorXcd LumpedLinearPart::displacement(int n, double w, const Eigen::VectorXcd& contact_force) const {
   const double big_w = n * w;
-  const Eigen::MatrixXcd dyn = k_.cast<std::complex<double>>() - big_w * big_w * m_.cast<std::complex<double>>() +
-                               std::complex<double>(0.0, big_w) * c_.cast<std::complex<double>>();
+  const Eigen::MatrixXcd dyn = dynamic_matrix(big_w);
   Eigen::VectorXcd f = -b_.transpose().cast<std::complex<double>>() * contact_force;
   if (n == 1) f[excited_dof_] += force_;
   return Eigen::PartialPivLU<Eigen::MatrixXcd>(dyn).solve(f);

@@ -53,6 +53,8 @@ class LumpedLinearPart : public LinearPart {
   }
 
  private:
+  /// D = K - W^2 M + i W C at circular frequency W = n w.
+  Eigen::MatrixXcd dynamic_matrix(double big_w) const;
   /// Complex displacements of every DOF for harmonic n under contact forces F_n.
   Eigen::VectorXcd displacement(int n, double w, const Eigen::VectorXcd& contact_force) const;
 

@@ -532,8 +532,8 @@ ForcedResponseOutcome trace_raising_time_samples(Context& ctx) {
       o.failure = e.what();
     }
     attempts.push_back({{"time_samples", n}, {"passed", o.failure.empty()}, {"message", o.failure}});
-    if (!o.failure.empty()) note_energy(tc.report.json().value("frf", nlohmann::json::object()), n);
     if (!o.failure.empty()) {
+      note_energy(tc.report.json().value("frf", nlohmann::json::object()), n);
       tried += "; traced again with N = " + std::to_string(n) + ": " + o.failure;
       continue;
     }
