@@ -395,6 +395,164 @@ bool extents_cover(const std::vector<const std::vector<continuation::BranchPoint
 
 }  // namespace
 
+namespace {
+
+// The stretches of [lo, hi] that no piece spans (a piece spans its lowest to its highest
+// frequency), from low to high.
+std::vector<std::pair<double, double>> uncovered_stretches(const std::vector<continuation::BranchPoint>& points,
+                                                           const std::vector<int>& piece, double lo, double hi) {
+  std::vector<std::pair<double, double>> spans;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const std::size_t k = static_cast<std::size_t>(piece[i]);
+    if (spans.size() <= k)
+      spans.resize(k + 1, {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()});
+    spans[k].first = std::min(spans[k].first, points[i].lambda);
+    spans[k].second = std::max(spans[k].second, points[i].lambda);
+  }
+  std::sort(spans.begin(), spans.end());
+  // A piece that reached an end is put on it to the tracing's slack (continuation::trace).
+  const double slack = 1e-9 * (hi - lo);
+  std::vector<std::pair<double, double>> gaps;
+  double covered = lo;
+  for (const auto& [a, b] : spans) {
+    if (!(a <= b)) continue;  // a piece number without points
+    if (a > covered + slack) gaps.emplace_back(covered, std::min(a, hi));
+    covered = std::max(covered, b);
+    if (covered >= hi) break;
+  }
+  if (covered < hi - slack) gaps.emplace_back(covered, hi);
+  return gaps;
+}
+
+double total_length(const std::vector<std::pair<double, double>>& stretches) {
+  double sum = 0.0;
+  for (const auto& [a, b] : stretches) sum += b - a;
+  return sum;
+}
+
+// Hops (docs/continuation.md, "Hops past a stopped piece"): at most this many new starts.
+constexpr int kMaxHops = 6;
+
+// Where the pieces leave part of the range without a solution (a piece closed on itself on a
+// loop of the sampled law, turned back, or stalled, and the far end has no start), a start is
+// sought inside the uncovered stretch: Newton at fixed frequency from the point of the piece
+// that ends there, 1, 4 and 16 initial steps in; then the whole start search in the stretch's
+// middle. From it a piece is traced to each end of the stretch and a little past (to meet the
+// piece there). Each new piece is one continuous path of solutions, so the range is covered
+// when no stretch is left; whether the new pieces join the ones they run into is the join test
+// of the second piece. Returns whether the range is covered; `notes` says what was tried, and
+// `joined` is cleared when a new piece that reached a neighbour does not join it.
+bool hop_over_gaps(FrequencyResponse& out, const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                   ReducedEquations& equations, const continuation::ArclengthOptions& ao,
+                   const std::function<void(const continuation::BranchPoint&, int)>& progress, const Info& info,
+                   std::string& notes, bool& joined) {
+  const double lo = std::min(ao.lambda_start, ao.lambda_end), hi = std::max(ao.lambda_start, ao.lambda_end);
+  const double direction = ao.lambda_end > ao.lambda_start ? 1.0 : -1.0;
+  const double step_hz = ao.initial_step * ao.lambda_scale;
+  const double overlap = 4.0 * step_hz;
+  auto note = [&](const std::string& s) { notes += (notes.empty() ? "" : "; ") + s; };
+  for (int hop = 0; hop < kMaxHops; ++hop) {
+    const auto gaps = uncovered_stretches(out.points, out.piece, lo, hi);
+    if (gaps.empty()) return true;
+    const int left = ao.max_points - static_cast<int>(out.points.size());
+    if (left < 4) {
+      note("no points left to fill " + shortest(gaps.front().first) + " .. " + shortest(gaps.front().second) + " Hz");
+      return false;
+    }
+    // The first stretch in the direction of travel.
+    const auto [a, b] = direction > 0 ? gaps.front() : gaps.back();
+    // Seeds: the points of the pieces at the stretch's ends (none at an end of the range).
+    struct Seed {
+      double lambda;
+      const continuation::BranchPoint* from;
+    };
+    std::vector<Seed> seeds;
+    auto nearest = [&](double f) {
+      const continuation::BranchPoint* best = nullptr;
+      for (const auto& p : out.points)
+        if (!best || std::abs(p.lambda - f) < std::abs(best->lambda - f)) best = &p;
+      return best;
+    };
+    for (double in : {1.0, 4.0, 16.0}) {
+      const double d = in * step_hz;
+      if (2.0 * d >= b - a) break;
+      if (a > lo && !out.points.empty()) seeds.push_back({a + d, nearest(a)});
+      if (b < hi && !out.points.empty()) seeds.push_back({b - d, nearest(b)});
+    }
+    Eigen::VectorXd x;
+    double f0 = 0.0;
+    std::string how;
+    for (const Seed& s : seeds) {
+      Eigen::VectorXd guess = s.from->x;
+      if (continuation::newton_fixed(equations, guess, s.lambda, ao) >= 0) {
+        x = guess;
+        f0 = s.lambda;
+        how = "Newton from the point at " + shortest(s.from->lambda) + " Hz";
+        break;
+      }
+    }
+    if (x.size() == 0) {
+      const double mid = 0.5 * (a + b);
+      try {
+        x = find_start_logged(model, eo, equations, ao, mid, how, info);
+        f0 = mid;
+      } catch (const NumericalError& e) {
+        note("no start in " + shortest(a) + " .. " + shortest(b) + " Hz (Newton from the pieces' ends failed; at " +
+             shortest(mid) + " Hz: " + e.what() + ")");
+        return false;
+      }
+    }
+    ++out.hops;
+    say(info, "frf: no solution traced in " + shortest(a) + " .. " + shortest(b) + " Hz; a start at " + shortest(f0) +
+                  " Hz (" + how + "), traced both ways");
+    const double before = total_length(gaps);
+    for (const double bound : {std::min(hi, b + overlap), std::max(lo, a - overlap)}) {
+      if (!(std::abs(bound - f0) > 0)) continue;
+      continuation::ArclengthOptions o = ao;
+      o.lambda_start = f0;
+      o.lambda_end = bound;
+      o.max_points = std::max(2, (ao.max_points - static_cast<int>(out.points.size())) / 2);
+      const continuation::Branch piece = continuation::trace(equations, x, o);
+      add_counts(out.summary, piece);
+      if (piece.points.empty()) continue;
+      // Reached a neighbouring piece: it joins if its last point lies on one.
+      const bool neighbour = piece.status == continuation::BranchStatus::kReachedEnd && bound > lo && bound < hi;
+      if (neighbour) {
+        double d = std::numeric_limits<double>::infinity();
+        const int n_before = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
+        for (int k = 0; k < n_before; ++k) {
+          std::vector<continuation::BranchPoint> pts;
+          for (std::size_t i = 0; i < out.points.size(); ++i)
+            if (out.piece[i] == k) pts.push_back(out.points[i]);
+          d = std::min(d, continuation::distance_to_branch(equations, ao, pts, piece.points.back()));
+        }
+        out.join_distance = std::max(out.join_distance, d);
+        if (!(d <= kJoinTolerance)) joined = false;
+      } else if (piece.status != continuation::BranchStatus::kReachedEnd) {
+        joined = false;  // it stopped short of the piece beyond: no join measured
+        out.join_distance = std::numeric_limits<double>::infinity();
+      }
+      const int k = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
+      for (const auto& p : piece.points) {
+        out.points.push_back(p);
+        out.piece.push_back(k);
+        if (progress) progress(p, k);
+      }
+      note("piece " + std::to_string(k) + " from " + shortest(f0) + " Hz (" + how + ") towards " + shortest(bound) +
+           " Hz: " + (piece.message.empty() ? std::string("reached it") : piece.message));
+    }
+    if (!(total_length(uncovered_stretches(out.points, out.piece, lo, hi)) < before)) {
+      note("the hop covered nothing new");
+      return false;
+    }
+  }
+  const bool covered = uncovered_stretches(out.points, out.piece, lo, hi).empty();
+  if (!covered) note("stopped after " + std::to_string(kMaxHops) + " hops");
+  return covered;
+}
+
+}  // namespace
+
 double free_motion_peak(const frf::LinearPart& linear, const ReducedEquations& equations, double f_start,
                         double f_end) {
   std::vector<double> at;
@@ -462,6 +620,123 @@ std::vector<std::size_t> prominent_maxima(const std::vector<double>& a, double m
 
 namespace {
 
+// The results of every point (energy balance polished where it misses) and the located peaks.
+void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSettings& settings,
+                              ReducedEquations& equations, const continuation::ArclengthOptions& ao) {
+  for (auto& p : out.points) {
+    out.results.push_back(equations.analyse(p.x, p.lambda));
+    // The energy balance is only as good as W: the corrector's tolerance is relative to the
+    // x unit (the free motion), which can exceed the motion at a point by orders of magnitude
+    // (a stiff stuck contact nearly clamping the structure). A point whose balance misses is
+    // polished once by Newton at its own scale before it is judged.
+    if (out.results.back().energy_error > kPolishAbove) {
+      continuation::ArclengthOptions fine = ao;
+      const double own = p.x.lpNorm<Eigen::Infinity>();
+      if (!(own > 0)) continue;
+      fine.x_scale = Eigen::VectorXd::Constant(p.x.size(), own);
+      fine.tolerance = kPolishTolerance;
+      Eigen::VectorXd x = p.x;
+      if (continuation::newton_fixed(equations, x, p.lambda, fine) >= 0) {
+        PointResult polished = equations.analyse(x, p.lambda);
+        if (polished.energy_error < out.results.back().energy_error) {
+          p.x = x;
+          out.results.back() = polished;
+          ++out.polished_points;
+        }
+      }
+    }
+  }
+
+  // Resonance peaks, located along the branch.
+  const auto t0 = std::chrono::steady_clock::now();
+  const int n_pieces = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
+  for (int pc = 0; pc < n_pieces; ++pc) {
+    std::vector<std::size_t> idx;
+    std::vector<double> amp;
+    for (std::size_t i = 0; i < out.points.size(); ++i)
+      if (out.piece[i] == pc) idx.push_back(i), amp.push_back(out.results[i].amplitude);
+    constexpr double kMinProminence = 0.02;  // a local maximum 2 % above its surroundings
+    for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
+      const std::size_t i = idx[m];
+      ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false, out.points[i].x};
+      if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
+        int evaluations = 0;
+        continuation::ScaledSystem sys(equations, ao, &evaluations);
+        continuation::ArclengthOptions fine = ao;
+        const double own = out.points[i].x.lpNorm<Eigen::Infinity>();
+        const double unit = ao.x_scale.size() > 0 ? ao.x_scale.maxCoeff() : 1.0;
+        if (own > 0 && unit > 0) fine.tolerance = std::min(ao.tolerance, kPeakTolerance * own / unit);
+        const Amplitude amplitude = [&](const Eigen::VectorXd& x, double lambda) {
+          return equations.analyse(x, lambda).amplitude;
+        };
+        // On the two steps beside the sampled maximum, each parametrized by the arclength
+        // along the tangent of its first point.
+        const std::array<const continuation::BranchPoint*, 3> pts = {&out.points[idx[m - 1]], &out.points[i],
+                                                                     &out.points[idx[m + 1]]};
+        std::array<double, 2> lengths{0.0, 0.0};
+        continuation::Extremum best;
+        int found_evaluations = 0;
+        for (int k = 0; k < 2; ++k) {
+          const continuation::BranchPoint& p = *pts[k];
+          const continuation::BranchPoint& q = *pts[k + 1];
+          lengths[k] = p.tangent.dot(sys.to_scaled(q.x, q.lambda) - sys.to_scaled(p.x, p.lambda));
+          if (!(lengths[k] > 0)) continue;
+          // At the tight tolerance; where the corrector cannot reach it, at the tracing one.
+          continuation::Extremum e = continuation::locate_maximum(equations, fine, p, lengths[k], amplitude);
+          found_evaluations += e.evaluations;
+          if (!e.found) {
+            e = continuation::locate_maximum(equations, ao, p, lengths[k], amplitude);
+            found_evaluations += e.evaluations;
+          }
+          keep_larger(best, e);
+        }
+        if (best.found)
+          best = search_rippled_top(
+              equations, fine, ao, pts,
+              {out.results[idx[m - 1]].amplitude, out.results[i].amplitude, out.results[idx[m + 1]].amplitude}, lengths,
+              best, amplitude, found_evaluations);
+        out.summary.residual_evaluations += found_evaluations;
+        if (best.found) {
+          peak.located = true;  // if no trial point beats the sampled one, it is the maximum to tolerance
+          if (best.value > peak.amplitude_m)
+            peak.amplitude_m = best.value, peak.frequency_hz = best.lambda, peak.x = best.x;
+        }
+      }
+      out.peaks.push_back(peak);
+    }
+  }
+  out.peaks = distinct_peaks(std::move(out.peaks), ao.lambda_scale);
+  out.peak_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A curve that stopped short (not at max_points) with part of the range uncovered: the hops
+// (hop_over_gaps). Covered: the curve reaches the end, in pieces, with a warning that says so;
+// otherwise what the hops tried is added to the reason it stopped.
+void hop_if_uncovered(FrequencyResponse& out, const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
+                      ReducedEquations& equations, const continuation::ArclengthOptions& ao,
+                      const std::function<void(const continuation::BranchPoint&, int)>& progress, const Info& info) {
+  const auto status = out.summary.status;
+  if (status == continuation::BranchStatus::kReachedEnd || status == continuation::BranchStatus::kMaxPoints) return;
+  const std::string stopped = out.summary.message;
+  std::string notes;
+  bool joined = out.pieces_join;
+  const std::size_t before = out.points.size();
+  if (hop_over_gaps(out, model, eo, equations, ao, progress, info, notes, joined)) {
+    out.pieces_join = joined;
+    out.two_pieces = true;
+    out.summary.status = continuation::BranchStatus::kReachedEnd;
+    out.summary.message = "";
+    const int n = *std::max_element(out.piece.begin(), out.piece.end()) + 1;
+    out.warnings.push_back(
+        "the curve is " + std::to_string(n) + " pieces" +
+        (joined ? " that join" : " that together cover the range but were not all shown to be one branch") +
+        ": the pieces traced from the ends stopped (" + (stopped.empty() ? "no start" : stopped) +
+        "), and starts past where they stopped gave the rest: " + notes + " (frf.csv column `piece`)");
+  } else {
+    out.summary.message = stopped + "; " + (out.points.size() > before ? "past where it stopped: " : "") + notes;
+  }
+}
+
 FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const ForcedModel& model,
                              const hbm::ContactEvaluatorOptions& eo, ReducedEquations& equations,
                              const std::function<void(const continuation::BranchPoint&, int)>& progress,
@@ -485,8 +760,32 @@ FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const Fo
       r.start = "from the end of the range, " + r.start + " (none at " + shortest(ao.lambda_start) + " Hz)";
       return r;
     } catch (const NumericalError& e2) {
-      const std::string both = std::string(e.what()) + "; from the end of the range, " + shortest(ao.lambda_end) +
-                               " Hz, none either: " + e2.what();
+      std::string both = std::string(e.what()) + "; from the end of the range, " + shortest(ao.lambda_end) +
+                         " Hz, none either: " + e2.what();
+      // No start at either end: a start inside the range, traced both ways (hop_over_gaps).
+      out.summary.status = continuation::BranchStatus::kStartFailed;
+      std::string notes;
+      bool joined = true;
+      if (hop_over_gaps(out, model, eo, equations, ao, progress, info, notes, joined)) {
+        out.start = "inside the range (none at either end: " + both + ")";
+        out.pieces_join = joined;
+        out.two_pieces = true;
+        out.summary.status = continuation::BranchStatus::kReachedEnd;
+        out.warnings.push_back("no start at either end of the range; the curve was traced from inside it: " + notes +
+                               (joined ? "" : " (not all shown to be one branch)") + " (frf.csv column `piece`)");
+        analyse_and_locate_peaks(out, settings, equations, ao);
+        return out;
+      }
+      both += "; inside the range: " + notes;
+      if (!out.points.empty()) {
+        // Pieces were traced inside the range but do not cover it: written with the reason.
+        out.start = "inside the range (none at either end)";
+        out.pieces_join = false;
+        out.two_pieces = true;
+        out.summary.message = both;
+        analyse_and_locate_peaks(out, settings, equations, ao);
+        return out;
+      }
       if (dynamic_cast<const NoPeriodicMotion*>(&e) && dynamic_cast<const NoPeriodicMotion*>(&e2))
         throw NoPeriodicMotion(both);
       throw NumericalError(both);
@@ -654,91 +953,9 @@ FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const Fo
       out.summary.message = first_message + "; no start point at the end of the range either: " + e.what();
     }
   }
+  hop_if_uncovered(out, model, eo, equations, ao, progress, info);
 
-  for (auto& p : out.points) {
-    out.results.push_back(equations.analyse(p.x, p.lambda));
-    // The energy balance is only as good as W: the corrector's tolerance is relative to the
-    // x unit (the free motion), which can exceed the motion at a point by orders of magnitude
-    // (a stiff stuck contact nearly clamping the structure). A point whose balance misses is
-    // polished once by Newton at its own scale before it is judged.
-    if (out.results.back().energy_error > kPolishAbove) {
-      continuation::ArclengthOptions fine = ao;
-      const double own = p.x.lpNorm<Eigen::Infinity>();
-      if (!(own > 0)) continue;
-      fine.x_scale = Eigen::VectorXd::Constant(p.x.size(), own);
-      fine.tolerance = kPolishTolerance;
-      Eigen::VectorXd x = p.x;
-      if (continuation::newton_fixed(equations, x, p.lambda, fine) >= 0) {
-        PointResult polished = equations.analyse(x, p.lambda);
-        if (polished.energy_error < out.results.back().energy_error) {
-          p.x = x;
-          out.results.back() = polished;
-          ++out.polished_points;
-        }
-      }
-    }
-  }
-
-  // Resonance peaks, located along the branch.
-  const auto t0 = std::chrono::steady_clock::now();
-  const int n_pieces = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
-  for (int pc = 0; pc < n_pieces; ++pc) {
-    std::vector<std::size_t> idx;
-    std::vector<double> amp;
-    for (std::size_t i = 0; i < out.points.size(); ++i)
-      if (out.piece[i] == pc) idx.push_back(i), amp.push_back(out.results[i].amplitude);
-    constexpr double kMinProminence = 0.02;  // a local maximum 2 % above its surroundings
-    for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
-      const std::size_t i = idx[m];
-      ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false, out.points[i].x};
-      if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
-        int evaluations = 0;
-        continuation::ScaledSystem sys(equations, ao, &evaluations);
-        continuation::ArclengthOptions fine = ao;
-        const double own = out.points[i].x.lpNorm<Eigen::Infinity>();
-        const double unit = ao.x_scale.size() > 0 ? ao.x_scale.maxCoeff() : 1.0;
-        if (own > 0 && unit > 0) fine.tolerance = std::min(ao.tolerance, kPeakTolerance * own / unit);
-        const Amplitude amplitude = [&](const Eigen::VectorXd& x, double lambda) {
-          return equations.analyse(x, lambda).amplitude;
-        };
-        // On the two steps beside the sampled maximum, each parametrized by the arclength
-        // along the tangent of its first point.
-        const std::array<const continuation::BranchPoint*, 3> pts = {&out.points[idx[m - 1]], &out.points[i],
-                                                                     &out.points[idx[m + 1]]};
-        std::array<double, 2> lengths{0.0, 0.0};
-        continuation::Extremum best;
-        int found_evaluations = 0;
-        for (int k = 0; k < 2; ++k) {
-          const continuation::BranchPoint& p = *pts[k];
-          const continuation::BranchPoint& q = *pts[k + 1];
-          lengths[k] = p.tangent.dot(sys.to_scaled(q.x, q.lambda) - sys.to_scaled(p.x, p.lambda));
-          if (!(lengths[k] > 0)) continue;
-          // At the tight tolerance; where the corrector cannot reach it, at the tracing one.
-          continuation::Extremum e = continuation::locate_maximum(equations, fine, p, lengths[k], amplitude);
-          found_evaluations += e.evaluations;
-          if (!e.found) {
-            e = continuation::locate_maximum(equations, ao, p, lengths[k], amplitude);
-            found_evaluations += e.evaluations;
-          }
-          keep_larger(best, e);
-        }
-        if (best.found)
-          best = search_rippled_top(
-              equations, fine, ao, pts,
-              {out.results[idx[m - 1]].amplitude, out.results[i].amplitude, out.results[idx[m + 1]].amplitude}, lengths,
-              best, amplitude, found_evaluations);
-        out.summary.residual_evaluations += found_evaluations;
-        if (best.found) {
-          peak.located = true;  // if no trial point beats the sampled one, it is the maximum to tolerance
-          if (best.value > peak.amplitude_m)
-            peak.amplitude_m = best.value, peak.frequency_hz = best.lambda, peak.x = best.x;
-        }
-      }
-      out.peaks.push_back(peak);
-    }
-  }
-  out.peaks = distinct_peaks(std::move(out.peaks), ao.lambda_scale);
-  out.peak_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  analyse_and_locate_peaks(out, settings, equations, ao);
   return out;
 }
 

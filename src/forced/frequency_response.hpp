@@ -100,7 +100,9 @@ std::vector<Eigen::VectorXd> solutions_at_frequency(const FrequencyResponse& res
 
 struct FrequencyResponse {
   std::vector<continuation::BranchPoint> points;  ///< every point, piece after piece
-  std::vector<int> piece;  ///< of each point: 0, 1 traced back from the end, 2 and 3 both ways from a gap's middle
+  /// of each point: 0, 1 traced back from the end, 2 and 3 both ways from a gap's middle, then
+  /// two per hop past a stopped piece (docs/continuation.md, "Hops past a stopped piece")
+  std::vector<int> piece;
   std::vector<PointResult> results;        ///< analyse() of each point
   std::vector<ResponsePeak> peaks;         ///< by frequency
   continuation::Branch summary;            ///< status, message and counts of all pieces (no points)
@@ -112,6 +114,7 @@ struct FrequencyResponse {
   std::vector<std::string> warnings;
   double peak_seconds = 0.0;  ///< time spent locating peaks
   int polished_points = 0;    ///< points re-solved at their own scale for the energy balance
+  int hops = 0;               ///< starts past where pieces stopped (docs/continuation.md, "Hops")
 };
 
 /// No start at either end of the range, and at each a time integration from rest (lumped

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -412,6 +413,226 @@ frequency_end_hz = 1391.629964680137)");
   double widest = 0.0;
   for (std::size_t i = 1; i < f.size(); ++i) widest = std::max(widest, f[i] - f[i - 1]);
   EXPECT_LT(widest, 0.01 * (f1 - f0));  // no stretch of the range left without points
+}
+
+// The frequency extents of frf.csv's pieces (column `piece`), merged: whether every frequency
+// of [f0, f1] lies between the lowest and the highest frequency of some piece.
+bool pieces_cover(const std::vector<std::vector<std::string>>& rows, double f0, double f1) {
+  std::size_t piece_col = rows[0].size();
+  for (std::size_t c = 0; c < rows[0].size(); ++c)
+    if (rows[0][c] == "piece") piece_col = c;
+  if (piece_col == rows[0].size()) return false;
+  std::map<int, std::pair<double, double>> span;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const int k = std::stoi(rows[i][piece_col]);
+    const double f = std::stod(rows[i][0]);
+    auto it = span.find(k);
+    if (it == span.end()) span[k] = {f, f};
+    else it->second = {std::min(it->second.first, f), std::max(it->second.second, f)};
+  }
+  std::vector<std::pair<double, double>> spans;
+  for (const auto& [k, s] : span) spans.push_back(s);
+  std::sort(spans.begin(), spans.end());
+  const double slack = 1e-9 * (f1 - f0);  // a piece that reached an end is put on it to this
+  double covered = f0;
+  for (const auto& [a, b] : spans) {
+    if (a > covered + slack) return false;
+    covered = std::max(covered, b);
+  }
+  return covered >= f1 - slack;
+}
+
+TEST(CliContinuation, PastAPieceThatClosedOnItselfTheCurveGoesOnFromANewStart) {
+  // Stress corpus model 154 (full3d, kt 4,160 times the structure's stiffness, zeta 4e-4) at
+  // N = 256: the branch from 12.66 Hz closes on itself on a loop of the sampled law near
+  // 13.08 Hz, the one traced back from 28.35 Hz near 21.76 Hz, and of the two pieces from the
+  // middle of that gap one closes on itself too, near 13.18 Hz. Before the hops the run
+  // stopped there (exit 3). A start just past where a piece stopped (Newton from that piece's
+  // last point, else the whole start search in the stretch left uncovered), traced both ways,
+  // covers the rest: exit 0, more than the four pieces of the middle search, and the report
+  // says they were not all shown to be one branch unless they passed the join test.
+  const Scratch s("hops");
+  s.write("case.toml", R"(name = "stress_0154"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[13.814332609063378, 0.0, 0.0, 0.0], [0.0, 61.907424596993366, 0.0, 0.0], [0.0, 0.0, 65.05893911886453, 0.0], [0.0, 0.0, 0.0, 50.206374742552015]]
+stiffness = [[448906.7750189198, -19381.637961102744, 17273.40478248263, 10484.781392774581], [-19381.637961102744, 599360.7723250751, -118829.7816038158, -193403.48023575134], [17273.40478248263, -118829.7816038158, 504661.5989044049, 152300.852037347], [10484.781392774581, -193403.48023575134, 152300.852037347, 702335.8346729153]]
+damping = [[4.75342249408158, -0.20522994747087148, 0.18290610748516486, 0.11102215090392023], [-0.20522994747087148, 6.346562662414807, -1.2582749654838095, -2.047927330451932], [0.18290610748516486, -1.2582749654838095, 5.343803946889129, 1.612696301835952], [0.11102215090392023, -2.047927330451932, 1.612696301835952, 7.436953819182371]]
+
+[excitation]
+force = 401.5283804791073
+dof = 2
+
+[response]
+dof = 1
+
+[contact]
+model = "full3d"
+friction_coefficient = 0.7154487416904293
+tangential_stiffness = 2348195090.069985
+normal_stiffness = 1263063.0126657402
+normal_preload = 252.4071610291438
+frame_angle_deg = 0.0
+
+[[contact.elements]]
+x_dof = 2
+y_dof = 0
+z_dof = 1
+
+[hbm]
+harmonics = 3
+time_samples = 256
+
+[continuation]
+frequency_start_hz = 12.658354212715707
+frequency_end_hz = 28.35090486285054)");
+  const CliResult r = s.run("frf case.toml --quiet --set hbm.raise_time_samples=false");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("starts past where they stopped gave the rest"), std::string::npos) << r.err;
+  const auto frf = frf_of(s, "results/stress_0154");
+  EXPECT_GT(frf["pieces"].get<int>(), 4);
+  EXPECT_TRUE(frf["energy_check_passed"].get<bool>());
+  // The join test of frequency_response.cpp (kJoinTolerance, scaled units); a piece that
+  // stopped short of its neighbour has no join distance (null).
+  constexpr double kJoinTolerance = 1e-5;
+  if (frf["pieces_join"].get<bool>()) {
+    EXPECT_LE(frf["join_distance"].get<double>(), kJoinTolerance);
+  } else {
+    EXPECT_NE(r.err.find("not all shown to be one branch"), std::string::npos) << r.err;
+    if (frf["join_distance"].is_number()) {
+      EXPECT_GT(frf["join_distance"].get<double>(), kJoinTolerance);
+    }
+  }
+  // Checked from frf.csv alone: the pieces' frequency extents cover the range, and every point
+  // lies in it (to the tracing's slack).
+  const auto rows = csv_rows(slurp(s.dir() / "results" / "stress_0154" / "frf.csv"));
+  const double f0 = 12.658354212715707, f1 = 28.35090486285054;
+  ASSERT_GT(rows.size(), 100u);
+  EXPECT_TRUE(pieces_cover(rows, f0, f1));
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const double f = std::stod(rows[i][0]);
+    EXPECT_GE(f, f0 - 1e-9 * f0);
+    EXPECT_LE(f, f1 + 1e-9 * f1);
+  }
+}
+
+TEST(CliContinuation, ACurveJoinedOnlyByHopsGivesWayToAFinerSamplingThatNeedsNone) {
+  // Stress corpus model 58 at its N = 64: the pieces from the ends stop, and the hops cover the
+  // rest in pieces not shown to be one branch, with a larger peak than the curve at N = 256,
+  // which needs no hop. With hbm.raise_time_samples (the default) the finer N is tried and is
+  // the result; the N = 64 curve is kept only where no finer N does better. Without it, the
+  // curve in pieces is the result (exit 0, its hops counted).
+  const Scratch s("hops_or_finer");
+  s.write("case.toml", R"(name = "stress_0058"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[6.303228595967036, 0.0, 0.0, 0.0], [0.0, 1.0926034600016292, 0.0, 0.0], [0.0, 0.0, 1.378425480327431, 0.0], [0.0, 0.0, 0.0, 1.8669798261590043]]
+stiffness = [[465.2332706330768, 92.727249849641, 6.993668200307193, -8.570739205957745], [92.727249849641, 607.2453741380245, 142.25664526528422, -160.15505936649743], [6.993668200307193, 142.25664526528422, 962.958472498098, 105.70374681883405], [-8.570739205957745, -160.15505936649743, 105.70374681883405, 470.2728439294243]]
+damping = [[0.579382259021919, 0.027811430509912367, 0.0020975917810311336, -0.002570598375683393], [0.027811430509912367, 0.25837249716730765, 0.04266664665224107, -0.048034869055263774], [0.0020975917810311336, 0.04266664665224107, 0.38500552420820955, 0.031703435765174426], [-0.002570598375683393, -0.048034869055263774, 0.031703435765174426, 0.2713275219785402]]
+
+[excitation]
+force = 77.86869524095493
+dof = 3
+
+[response]
+dof = 0
+
+[contact]
+model = "full3d"
+friction_coefficient = 0.4633797382543974
+tangential_stiffness = 604404.8317925647
+normal_stiffness = 2199743.3342519156
+normal_preload = 0.005022327237656415
+frame_angle_deg = 88.29268957931117
+
+[[contact.elements]]
+x_dof = 0
+y_dof = 2
+z_dof = 3
+
+[hbm]
+harmonics = 2
+time_samples = 64
+
+[continuation]
+frequency_start_hz = 0.8932721449688094
+frequency_end_hz = 2.0593885510196044)");
+  const CliResult fixed = s.run("frf case.toml --quiet --out fixed --set hbm.raise_time_samples=false");
+  ASSERT_EQ(fixed.status, 0) << fixed.err;
+  const auto at64 = frf_of(s, "fixed");
+  EXPECT_EQ(at64["time_samples"].get<int>(), 64);
+  EXPECT_GT(at64["hops"].get<int>(), 0);
+  EXPECT_FALSE(at64["pieces_join"].get<bool>());
+  const CliResult raised = s.run("frf case.toml --quiet --out raised");
+  ASSERT_EQ(raised.status, 0) << raised.err;
+  const auto finer = frf_of(s, "raised");
+  EXPECT_GT(finer["time_samples"].get<int>(), 64);
+  EXPECT_EQ(finer["hops"].get<int>(), 0);
+  const auto& attempts = finer["time_samples_raised"]["attempts"];
+  ASSERT_GE(attempts.size(), 2u);
+  EXPECT_FALSE(attempts[0]["passed"].get<bool>());
+  EXPECT_NE(attempts[0]["message"].get<std::string>().find("only by hops"), std::string::npos) << attempts[0];
+  EXPECT_NE(raised.err.find("reached the end only by hops"), std::string::npos) << raised.err;
+}
+
+TEST(CliContinuation, WithNoStartAtEitherEndTheCurveIsSoughtInsideTheRangeAndWhatItFindsIsKept) {
+  // Stress corpus model 25 (quasi3d, 6 DOFs, the excitation 6e4 times the friction limit, so
+  // the contact separates): no start at 0.125 Hz nor at 0.223 Hz (no harmonic-balance start,
+  // and time integration finds no periodic motion at either). A start in the middle of the
+  // range (0.174 Hz) is traced both ways; neither piece gets through and the stretch below
+  // has no start either, so the run stops (exit 3), but the pieces found are written (before,
+  // the run stopped with nothing written) and run.json says where the start came from.
+  const Scratch s("inside");
+  s.write("case.toml", R"(name = "stress_0025"
+
+[structure]
+type = "lumped"
+sectors = 1
+mass = [[0.12060880851326367, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.1831494931516441, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.05957955445498279, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.05125342047198694, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.1224024616494912, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 0.03186353318906183]]
+stiffness = [[1.1265803777204322, -0.2543432213575282, -0.34419249173496497, 0.0859006940465509, -0.4534136146380125, 0.008335899984497476], [-0.2543432213575282, 0.9430806326547926, 0.32343965699740473, -0.043944594179658854, -0.25952015587423743, 0.27568602339313086], [-0.34419249173496497, 0.32343965699740473, 1.1472946768493382, 0.46607307934819836, 0.2797645422749079, 0.22598087332369354], [0.0859006940465509, -0.043944594179658854, 0.46607307934819836, 0.5053544832660387, 0.12990194385296247, 0.11222121394049711], [-0.4534136146380125, -0.25952015587423743, 0.2797645422749079, 0.12990194385296247, 0.6859928028612103, 0.005884016232945085], [0.008335899984497476, 0.27568602339313086, 0.22598087332369354, 0.11222121394049711, 0.005884016232945085, 0.4998011259278221]]
+damping = [[0.0002600400652518066, -3.6306725507343866e-05, -4.913243707621311e-05, 1.2262064241352112e-05, -6.472342199682398e-05, 1.1899245082234384e-06], [-3.6306725507343866e-05, 0.0002852978678105285, 4.6170032690932765e-05, -6.272957894835089e-06, -3.70457172503298e-05, 3.935334593987725e-05], [-4.913243707621311e-05, 4.6170032690932765e-05, 0.00021278857731219035, 6.653052229165172e-05, 3.9935542173481786e-05, 3.225808611639786e-05], [1.2262064241352112e-05, -6.272957894835089e-06, 6.653052229165172e-05, 0.00011430369727533475, 1.8543109555533304e-05, 1.6019238841483453e-05], [-6.472342199682398e-05, -3.70457172503298e-05, 3.9935542173481786e-05, 1.8543109555533304e-05, 0.0001986231490264923, 8.399255191865154e-07], [1.1899245082234384e-06, 3.935334593987725e-05, 3.225808611639786e-05, 1.6019238841483453e-05, 8.399255191865154e-07, 9.755903145235235e-05]]
+
+[excitation]
+force = 6104.132864748908
+dof = 1
+
+[response]
+dof = 4
+
+[contact]
+model = "quasi3d"
+friction_coefficient = 0.8282915073020134
+tangential_stiffness = 1.7587972085208725
+normal_stiffness = 1179.0159200198561
+normal_preload = 0.09845147424177142
+frame_angle_deg = 0.0
+
+[[contact.elements]]
+x_dof = 4
+y_dof = 3
+z_dof = 1
+
+[hbm]
+harmonics = 9
+time_samples = 128
+
+[continuation]
+frequency_start_hz = 0.12518401127621737
+frequency_end_hz = 0.22304599246229262)");
+  const CliResult r = s.run("frf case.toml --quiet --out out --set hbm.raise_time_samples=false");
+  ASSERT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("inside the range:"), std::string::npos) << r.err;
+  const auto frf = frf_of(s, "out");
+  EXPECT_EQ(frf["start"].get<std::string>(), "inside the range (none at either end)");
+  EXPECT_FALSE(frf["pieces_join"].get<bool>());
+  const auto rows = csv_rows(slurp(s.dir() / "out" / "frf.csv"));
+  EXPECT_GT(rows.size(), 100u);
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    for (const auto& v : rows[i]) EXPECT_EQ(v.find("nan"), std::string::npos) << "row " << i;
 }
 
 TEST(CliContinuation, TheMiddleBranchBetweenTwoFoldsIsReportedUnstable) {
