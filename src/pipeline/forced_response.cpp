@@ -340,7 +340,9 @@ ForcedResponseOutcome trace_case(Context& ctx) {
     outcome.failure = "the energy balance fails its check: error " + io::format_number(max_energy_error) + " at " +
                       io::format_number(worst_energy_f) +
                       " Hz exceeds hbm.energy_tolerance = " + io::format_number(c.hbm.energy_tolerance) +
-                      " (excitation work and dissipation per cycle disagree: raise hbm.time_samples, or relax "
+                      " (excitation work and dissipation per cycle disagree; at a harmonic-balance solution they "
+                      "balance whatever N, so the error measures how precisely the point is solved and the two "
+                      "formed from it, not the sampling: look at the worst point in frf.csv, or relax "
                       "hbm.energy_tolerance to accept the curve; " +
                       std::to_string(results.size()) + " points written to frf.csv)";
   } else if (branch.status != continuation::BranchStatus::kReachedEnd) {
