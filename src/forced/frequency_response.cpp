@@ -393,9 +393,10 @@ bool extents_cover(const std::vector<const std::vector<continuation::BranchPoint
   return covered >= std::max(a, b);
 }
 
-}  // namespace
-
-namespace {
+// The number of pieces of a curve (its largest piece number + 1; 0 without points).
+int piece_count(const FrequencyResponse& out) {
+  return out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
+}
 
 // The stretches of [lo, hi] that no piece spans (a piece spans its lowest to its highest
 // frequency), from low to high.
@@ -515,15 +516,15 @@ bool hop_over_gaps(FrequencyResponse& out, const ForcedModel& model, const hbm::
       const continuation::Branch piece = continuation::trace(equations, x, o);
       add_counts(out.summary, piece);
       if (piece.points.empty()) continue;
+      const int k = piece_count(out);  // the new piece's number
       // Reached a neighbouring piece: it joins if its last point lies on one.
       const bool neighbour = piece.status == continuation::BranchStatus::kReachedEnd && bound > lo && bound < hi;
       if (neighbour) {
         double d = std::numeric_limits<double>::infinity();
-        const int n_before = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
-        for (int k = 0; k < n_before; ++k) {
+        for (int j = 0; j < k; ++j) {
           std::vector<continuation::BranchPoint> pts;
           for (std::size_t i = 0; i < out.points.size(); ++i)
-            if (out.piece[i] == k) pts.push_back(out.points[i]);
+            if (out.piece[i] == j) pts.push_back(out.points[i]);
           d = std::min(d, continuation::distance_to_branch(equations, ao, pts, piece.points.back()));
         }
         out.join_distance = std::max(out.join_distance, d);
@@ -532,7 +533,6 @@ bool hop_over_gaps(FrequencyResponse& out, const ForcedModel& model, const hbm::
         joined = false;  // it stopped short of the piece beyond: no join measured
         out.join_distance = std::numeric_limits<double>::infinity();
       }
-      const int k = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
       for (const auto& p : piece.points) {
         out.points.push_back(p);
         out.piece.push_back(k);
@@ -649,7 +649,7 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
 
   // Resonance peaks, located along the branch.
   const auto t0 = std::chrono::steady_clock::now();
-  const int n_pieces = out.piece.empty() ? 0 : *std::max_element(out.piece.begin(), out.piece.end()) + 1;
+  const int n_pieces = piece_count(out);
   for (int pc = 0; pc < n_pieces; ++pc) {
     std::vector<std::size_t> idx;
     std::vector<double> amp;
@@ -726,9 +726,8 @@ void hop_if_uncovered(FrequencyResponse& out, const ForcedModel& model, const hb
     out.two_pieces = true;
     out.summary.status = continuation::BranchStatus::kReachedEnd;
     out.summary.message = "";
-    const int n = *std::max_element(out.piece.begin(), out.piece.end()) + 1;
     out.warnings.push_back(
-        "the curve is " + std::to_string(n) + " pieces" +
+        "the curve is " + std::to_string(piece_count(out)) + " pieces" +
         (joined ? " that join" : " that together cover the range but were not all shown to be one branch") +
         ": the pieces traced from the ends stopped (" + (stopped.empty() ? "no start" : stopped) +
         "), and starts past where they stopped gave the rest: " + notes + " (frf.csv column `piece`)");

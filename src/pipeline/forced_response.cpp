@@ -474,6 +474,9 @@ std::string without_written_note(const std::string& failure) {
   return note ? failure.substr(0, at) : failure;
 }
 
+/// What an attempt that reached the end only by hops apart (hopped_apart) is recorded as.
+constexpr const char* kHoppedApart = "reached the end only by hops, in pieces not shown to be one branch";
+
 /// Whether a curve (the report's "frf" section) reached the end only by hops past stopped
 /// pieces, in pieces not shown to be one branch (docs/continuation.md, "Hops").
 bool hopped_apart(const nlohmann::json& frf) { return frf.value("hops", 0) > 0 && !frf.value("pieces_join", true); }
@@ -522,8 +525,7 @@ ForcedResponseOutcome trace_raising_time_samples(Context& ctx) {
 
   log::Stopwatch clock;  // of the attempts with a raised N (the first is the "frf" stage)
   nlohmann::json attempts = nlohmann::json::array();
-  const std::string first_reason = provisional ? "reached the end only by hops, in pieces not shown to be one branch"
-                                               : first.failure;
+  const std::string first_reason = provisional ? kHoppedApart : first.failure;
   attempts.push_back({{"time_samples", n0}, {"passed", false}, {"message", first_reason}});
   std::string tried;
   // The energy errors of attempts that reached the end and failed only their energy check.
@@ -572,7 +574,7 @@ ForcedResponseOutcome trace_raising_time_samples(Context& ctx) {
       o.failure = e.what();
     }
     const bool apart = o.failure.empty() && hopped_apart(tc.report.json().value("frf", nlohmann::json::object()));
-    if (apart) o.failure = "reached the end only by hops, in pieces not shown to be one branch";
+    if (apart) o.failure = kHoppedApart;
     attempts.push_back({{"time_samples", n}, {"passed", o.failure.empty()}, {"message", o.failure}});
     if (apart && !provisional && !fallback) {
       fallback = std::make_unique<Context>(std::move(tc));
@@ -586,9 +588,7 @@ ForcedResponseOutcome trace_raising_time_samples(Context& ctx) {
       tried += "; traced again with N = " + std::to_string(n) + ": " + o.failure;
       continue;
     }
-    adopt(tc, n,
-          provisional ? "reached the end only by hops, in pieces not shown to be one branch"
-                      : "failed (" + without_written_note(first.failure) + ")");
+    adopt(tc, n, provisional ? kHoppedApart : "failed (" + without_written_note(first.failure) + ")");
     return o;
   }
   if (fallback) {
