@@ -269,6 +269,7 @@ std::string to_string(StabilityChange::Kind kind) {
     case StabilityChange::Kind::fold: return "fold";
     case StabilityChange::Kind::period_doubling: return "period_doubling";
     case StabilityChange::Kind::neimark_sacker: return "neimark_sacker";
+    case StabilityChange::Kind::unresolved: return "unresolved";
   }
   return "fold";
 }
@@ -277,22 +278,34 @@ std::vector<StabilityChange> stability_changes(const std::vector<FloquetResult>&
                                                const std::vector<double>& frequency_hz,
                                                const std::vector<double>& amplitude_m, const std::vector<int>& piece) {
   std::vector<StabilityChange> out;
+  // Each judged point with the next judged point of its piece (points not judged between them
+  // are skipped: the change lies somewhere between the two).
   for (std::size_t i = 0; i + 1 < stability.size(); ++i) {
-    const FloquetResult &a = stability[i], &b = stability[i + 1];
-    if (!a.available || !b.available || a.stable == b.stable || piece[i] != piece[i + 1]) continue;
+    if (!stability[i].available) continue;
+    std::size_t next = i + 1;
+    while (next < stability.size() && !stability[next].available && piece[next] == piece[i]) ++next;
+    if (next == stability.size()) break;
+    const FloquetResult &a = stability[i], &b = stability[next];
+    if (a.stable == b.stable || piece[i] != piece[next]) continue;
     const FloquetResult& unstable = a.stable ? b : a;
-    const double w = kTwoPi * (a.stable ? frequency_hz[i + 1] : frequency_hz[i]);
-    const double im = std::abs(unstable.exponents.front().imag()) / w;
+    const double w = kTwoPi * (a.stable ? frequency_hz[next] : frequency_hz[i]);
     StabilityChange c;
     c.point = i;
-    c.kind = im < kKindTolerance                   ? StabilityChange::Kind::fold
-             : std::abs(im - 0.5) < kKindTolerance ? StabilityChange::Kind::period_doubling
-                                                   : StabilityChange::Kind::neimark_sacker;
-    // Where max_real / w crosses zero, linearly between the two points.
-    const double ra = a.max_real / (kTwoPi * frequency_hz[i]), rb = b.max_real / (kTwoPi * frequency_hz[i + 1]);
-    const double t = ra == rb ? 0.5 : std::clamp(ra / (ra - rb), 0.0, 1.0);
-    c.frequency_hz = frequency_hz[i] + t * (frequency_hz[i + 1] - frequency_hz[i]);
-    c.amplitude_m = amplitude_m[i] + t * (amplitude_m[i + 1] - amplitude_m[i]);
+    double t = 0.5;
+    if (a.exponents.empty() || b.exponents.empty()) {
+      // A verdict without exponents (the shooting's march left the solution): kind and place unknown.
+      c.kind = StabilityChange::Kind::unresolved;
+    } else {
+      const double im = std::abs(unstable.exponents.front().imag()) / w;
+      c.kind = im < kKindTolerance                   ? StabilityChange::Kind::fold
+               : std::abs(im - 0.5) < kKindTolerance ? StabilityChange::Kind::period_doubling
+                                                     : StabilityChange::Kind::neimark_sacker;
+      // Where max_real / w crosses zero, linearly between the two points.
+      const double ra = a.max_real / (kTwoPi * frequency_hz[i]), rb = b.max_real / (kTwoPi * frequency_hz[next]);
+      t = ra == rb ? 0.5 : std::clamp(ra / (ra - rb), 0.0, 1.0);
+    }
+    c.frequency_hz = frequency_hz[i] + t * (frequency_hz[next] - frequency_hz[i]);
+    c.amplitude_m = amplitude_m[i] + t * (amplitude_m[next] - amplitude_m[i]);
     out.push_back(c);
   }
   return out;

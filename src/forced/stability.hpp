@@ -99,9 +99,9 @@ FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::Harmon
 
 /// Where the stability changes between two neighbouring points of a branch.
 struct StabilityChange {
-  enum class Kind { fold, period_doubling, neimark_sacker };
+  enum class Kind { fold, period_doubling, neimark_sacker, unresolved };
   Kind kind = Kind::fold;
-  std::size_t point = 0;                         ///< the change lies between point and point + 1
+  std::size_t point = 0;  ///< the change lies between point and the next judged point of its piece
   double frequency_hz = 0.0, amplitude_m = 0.0;  ///< linear interpolation where max_real crosses 0
 };
 std::string to_string(StabilityChange::Kind kind);

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "forced/element_law.hpp"
 #include "hbm/harmonic_layout.hpp"
 
 namespace shroudsim::forced {
@@ -27,53 +28,6 @@ constexpr int kSettledPeriods = 3;
 constexpr long long kConfirmPeriods = 200;
 constexpr double kSteadyChange = 1e-6;
 
-// The contact law of one element in continuous time (docs/physics.md section 4 without the
-// sampling): the step is far below the stick and slip time scales, so the slider update of the
-// sampled law ("radial_return") is exact to O(dt).
-struct ElementLaw {
-  contact::PairParameters p;
-  bool one_d = false, coupled = true;
-
-  // w: x, y, z of the element; d: slider (x, y), updated; f: force (Tx, Ty, N).
-  void force(const double* w, double* d, double* f) const {
-    const double kt = p.tangential_stiffness, mu = p.friction_coefficient;
-    const double n = one_d ? std::max(0.0, p.normal_preload)
-                           : std::max(0.0, p.normal_preload + p.normal_stiffness * w[2]);
-    f[2] = one_d ? 0.0 : n;
-    if (!(n > 0.0)) {  // separated: no force, the slider follows
-      d[0] = w[0];
-      d[1] = one_d ? 0.0 : w[1];
-      f[0] = f[1] = 0.0;
-      return;
-    }
-    const double limit = mu * n;
-    if (one_d || !coupled) {
-      for (int k = 0; k < (one_d ? 1 : 2); ++k) {
-        const double t = kt * (w[k] - d[k]);
-        if (std::abs(t) <= limit) {
-          f[k] = t;
-        } else {
-          f[k] = std::copysign(limit, t);
-          d[k] = w[k] - f[k] / kt;
-        }
-      }
-      if (one_d) f[1] = 0.0;
-      return;
-    }
-    const double tx = kt * (w[0] - d[0]), ty = kt * (w[1] - d[1]);
-    const double t = std::hypot(tx, ty);
-    if (t <= limit) {
-      f[0] = tx;
-      f[1] = ty;
-    } else {
-      f[0] = limit * tx / t;
-      f[1] = limit * ty / t;
-      d[0] = w[0] - f[0] / kt;
-      d[1] = w[1] - f[1] / kt;
-    }
-  }
-};
-
 }  // namespace
 
 bool TimeMarchOptions::validate(std::vector<std::string>* errors) const {
@@ -81,10 +35,7 @@ bool TimeMarchOptions::validate(std::vector<std::string>* errors) const {
     if (errors) errors->push_back(m);
     return false;
   };
-  bool ok = true;
-  if (min_steps_per_period < 16) ok = fail("min_steps_per_period >= 16");
-  if (!(steps_per_stiff_period >= 8.0) || !std::isfinite(steps_per_stiff_period))
-    ok = fail("steps_per_stiff_period >= 8 (the scheme is unstable from pi steps on)");
+  bool ok = detail::valid_steps(min_steps_per_period, steps_per_stiff_period, errors);
   if (max_periods < 1) ok = fail("max_periods >= 1");
   if (max_steps < 1) ok = fail("max_steps >= 1");
   if (max_period_multiple < 1) ok = fail("max_period_multiple >= 1");
@@ -112,6 +63,21 @@ std::string TimeMarchResult::describe() const {
   return "?";
 }
 
+double stuck_highest_circular_frequency(const LumpedSystem& s, const std::vector<contact::PairParameters>& pairs,
+                                        contact::Model model) {
+  const bool one_d = contact::n_directions(model) == 1;
+  Eigen::MatrixXd k_stuck = s.stiffness;
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    const Eigen::Index row = 3 * static_cast<Eigen::Index>(e);
+    const double k_dir[3] = {pairs[e].tangential_stiffness, one_d ? 0.0 : pairs[e].tangential_stiffness,
+                             one_d ? 0.0 : pairs[e].normal_stiffness};
+    for (int d = 0; d < 3; ++d)
+      k_stuck += k_dir[d] * s.contact_operator.row(row + d).transpose() * s.contact_operator.row(row + d);
+  }
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(k_stuck, s.mass, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
+}
+
 TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<contact::PairParameters>& pairs,
                                       contact::Model model, double frequency_hz, const TimeMarchOptions& o) {
   std::vector<std::string> errors;
@@ -126,26 +92,16 @@ TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<c
 
   TimeMarchResult r;
   const bool one_d = contact::n_directions(model) == 1;
-  std::vector<ElementLaw> laws;
+  std::vector<detail::ElementLaw> laws;
   for (const auto& p : pairs) laws.push_back({p, one_d, model != contact::Model::quasi3d});
 
-  // Highest natural frequency with every contact stuck (kt, kt, kn): the step bound.
-  Eigen::MatrixXd k_stuck = s.stiffness;
-  for (std::size_t e = 0; e < pairs.size(); ++e) {
-    const Eigen::Index row = 3 * static_cast<Eigen::Index>(e);
-    const double k_dir[3] = {pairs[e].tangential_stiffness, one_d ? 0.0 : pairs[e].tangential_stiffness,
-                             one_d ? 0.0 : pairs[e].normal_stiffness};
-    for (int d = 0; d < 3; ++d)
-      k_stuck += k_dir[d] * s.contact_operator.row(row + d).transpose() * s.contact_operator.row(row + d);
-  }
   const Eigen::LLT<Eigen::MatrixXd> mass_llt(s.mass);
   if (mass_llt.info() != Eigen::Success) {
     r.motion = TimeMarchResult::Motion::not_applicable;
     r.reason = "the mass matrix is not positive definite (a massless DOF needs an implicit scheme)";
     return r;
   }
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(k_stuck, s.mass, Eigen::EigenvaluesOnly);
-  const double w_max = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
+  const double w_max = stuck_highest_circular_frequency(s, pairs, model);
   const double w = kTwoPi * frequency_hz;
   const double steps_needed =
       std::max(static_cast<double>(o.min_steps_per_period), o.steps_per_stiff_period * w_max / w);

@@ -61,6 +61,12 @@ struct TimeMarchResult {
   std::string describe() const;
 };
 
+/// The highest natural circular frequency [rad/s] of the structure with every contact stuck
+/// (springs kt, kt, kn; kt only for the 1d models): the explicit scheme's step bound. The mass
+/// must be positive definite.
+double stuck_highest_circular_frequency(const LumpedSystem& system, const std::vector<contact::PairParameters>& pairs,
+                                        contact::Model model);
+
 /// Marches from rest (u = 0, v = 0, sliders at 0) at frequency f [Hz]. Throws
 /// std::invalid_argument for inconsistent sizes or invalid options.
 TimeMarchResult march_to_steady_state(const LumpedSystem& system, const std::vector<contact::PairParameters>& pairs,

@@ -45,6 +45,9 @@ class LumpedLinearPart : public LinearPart {
   const Eigen::MatrixXd& mass() const { return m_; }
   const Eigen::MatrixXd& stiffness() const { return k_; }
   const Eigen::MatrixXd& damping() const { return c_; }
+  /// Complex displacements of every DOF for harmonic n (circular frequency w) under contact
+  /// forces F_n (the excitation included for n = 1): (K - (n w)^2 M + i n w C)^-1 (f_n - B^T F_n).
+  Eigen::VectorXcd displacement(int n, double w, const Eigen::VectorXcd& contact_force) const;
   /// The excitation's force amplitude on every DOF (f(t) = force_vector() cos(w t)).
   Eigen::VectorXd force_vector() const {
     Eigen::VectorXd f = Eigen::VectorXd::Zero(m_.rows());
@@ -55,8 +58,6 @@ class LumpedLinearPart : public LinearPart {
  private:
   /// D = K - W^2 M + i W C at circular frequency W = n w.
   Eigen::MatrixXcd dynamic_matrix(double big_w) const;
-  /// Complex displacements of every DOF for harmonic n under contact forces F_n.
-  Eigen::VectorXcd displacement(int n, double w, const Eigen::VectorXcd& contact_force) const;
 
   Eigen::MatrixXd m_, k_, c_;
   std::vector<LumpedContact> contacts_;

@@ -2,6 +2,7 @@
 #include "pipeline/forced_response.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
@@ -15,7 +16,9 @@
 #include "forced/discretization_search.hpp"
 #include "forced/frequency_response.hpp"
 #include "forced/reduced_equations.hpp"
+#include "forced/shooting.hpp"
 #include "forced/stability.hpp"
+#include "frf/lumped.hpp"
 #include "hbm/contact_evaluator.hpp"
 #include "io/output.hpp"
 #include "linalg/parallel.hpp"
@@ -68,22 +71,18 @@ void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyRes
   io::write_file_atomic(file, csv.str());
 }
 
-/// The Floquet exponents of every point (forced/stability.hpp) and run.json's frf.stability:
-/// how many points are unstable, the changes of stability along each piece, the time taken.
-/// A point whose analysis fails is left out (empty in frf.csv) and counted.
-std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
-                                                     forced::ReducedEquations& equations, int threads) {
-  const log::Stopwatch clock;
+/// Hill's Floquet exponents of every point (forced/stability.hpp); errors[i] says why point i
+/// was not analysed.
+std::vector<forced::FloquetResult> hill_stability(const forced::FrequencyResponse& response,
+                                                  forced::ReducedEquations& equations, int threads,
+                                                  std::vector<std::string>& errors) {
   const std::size_t n = response.points.size();
   std::vector<forced::FloquetResult> out(n);
-  std::vector<double> freq, amp;
-  int unstable = 0, failed = 0, size = 0;
-  std::string failure;
+  errors.assign(n, std::string());
   // Per batch of points: their contact Jacobians in order (the evaluator is not shared between
   // threads), then their Hill problems in parallel. Each is a pure function of its point, so
   // the result does not depend on the thread count; the batch bounds the Jacobians held.
   constexpr std::size_t kBatch = 64;
-  std::vector<std::string> errors(n);
   std::vector<std::vector<Eigen::MatrixXd>> jacobians(kBatch);
   for (std::size_t first = 0; first < n; first += kBatch) {
     const std::size_t count = std::min(kBatch, n - first);
@@ -107,7 +106,82 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
       }
     });
   }
+  return out;
+}
+
+/// The Floquet multipliers of every point by shooting on the time integration
+/// (forced/shooting.hpp): the lumped models with friction, whose slider memory Hill's
+/// linearization drops. `s` gets the shooting's own figures.
+std::vector<forced::FloquetResult> shooting_stability(const forced::FrequencyResponse& response,
+                                                      forced::ReducedEquations& equations,
+                                                      const frf::LumpedLinearPart& lumped,
+                                                      const std::vector<contact::PairParameters>& pairs,
+                                                      contact::Model law, int threads, std::vector<std::string>& errors,
+                                                      nlohmann::json& s) {
+  const std::size_t n = response.points.size();
+  const forced::LumpedSystem system{lumped.mass(), lumped.damping(), lumped.stiffness(), lumped.contact_operator(),
+                                    lumped.force_vector()};
+  std::vector<Eigen::VectorXd> u0(n), v0(n), d0(n);
+  // The states from the harmonics in order (the equations are not shared between threads).
+  for (std::size_t i = 0; i < n; ++i)
+    forced::harmonic_balance_state(equations, lumped, pairs, law, response.points[i].x, response.points[i].lambda,
+                                   u0[i], v0[i], d0[i]);
+  // The work bound (forced::kShootingBudget): every stride-th point of a curve that would
+  // exceed it is judged, the others left undecided (the same points at any thread count).
+  const forced::ShootingOptions options;
+  double work = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    work += forced::shooting_work(system, pairs, law, response.points[i].lambda, options);
+  const std::size_t stride =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(work / forced::kShootingBudget)));
+  std::vector<forced::ShootingResult> shots(n);
+  errors.assign(n, std::string());
+  const int jobs = static_cast<int>(n);
+  linalg::parallel_for(jobs, linalg::worker_count(threads, jobs), [&](int i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (k % stride != 0 && k + 1 != n) {
+      shots[k].reason = "not judged: the shooting of every point would exceed its work bound, so every " +
+                        std::to_string(stride) + "th point is judged";
+      return;
+    }
+    shots[k] = forced::shooting_floquet(system, pairs, law, response.points[k].lambda, u0[k], v0[k], d0[k], options);
+  });
+  s["stride"] = stride;
+  std::vector<forced::FloquetResult> out(n);
+  double start_mismatch = 0.0, mismatch = 0.0;
+  int iterations = 0, steps = 0, state = 0, settled = 0, left = 0;
   for (std::size_t i = 0; i < n; ++i) {
+    out[i] = shots[i].to_floquet(response.points[i].lambda);
+    if (std::isfinite(shots[i].start_mismatch)) start_mismatch = std::max(start_mismatch, shots[i].start_mismatch);
+    if (!shots[i].available) {
+      if (!shots[i].reason.empty()) errors[i] = shots[i].reason;
+      continue;
+    }
+    settled += shots[i].settled ? 1 : 0;
+    left += shots[i].left ? 1 : 0;
+    if (!shots[i].left) mismatch = std::max(mismatch, shots[i].mismatch);
+    iterations = std::max(iterations, shots[i].newton_iterations);
+    steps = std::max(steps, shots[i].steps_per_period);
+    state = std::max(state, shots[i].state_size);
+  }
+  s["steps_per_period"] = steps;
+  s["state_size"] = state;
+  s["max_start_mismatch"] = start_mismatch;
+  s["max_mismatch"] = mismatch;
+  s["max_newton_iterations"] = iterations;
+  s["settled_points"] = settled;
+  s["left_points"] = left;
+  return out;
+}
+
+/// run.json's frf.stability from the points' results: how many points are unstable, the
+/// changes of stability along each piece. A point whose analysis failed is counted.
+void report_stability(nlohmann::json& s, const std::vector<forced::FloquetResult>& out,
+                      const std::vector<std::string>& errors, const forced::FrequencyResponse& response,
+                      const std::string& method) {
+  int unstable = 0, failed = 0, size = 0;
+  std::string failure;
+  for (std::size_t i = 0; i < out.size(); ++i) {
     if (!errors[i].empty()) {
       ++failed;
       failure = errors[i];
@@ -116,26 +190,29 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
     unstable += out[i].stable ? 0 : 1;
     size = std::max(size, out[i].hill_size);
   }
-  for (std::size_t i = 0; i < response.results.size(); ++i) {
-    freq.push_back(response.results[i].frequency_hz);
-    amp.push_back(response.results[i].amplitude);
+  std::vector<double> freq, amp;
+  for (const auto& r : response.results) {
+    freq.push_back(r.frequency_hz);
+    amp.push_back(r.amplitude);
   }
-  auto& s = j["stability"];
-  s = nlohmann::json::object();
   const bool any = std::any_of(out.begin(), out.end(), [](const auto& f) { return f.available; });
   s["available"] = any || failed > 0;
   if (!any && failed == 0) {
     s["reason"] = out.empty() ? std::string("no points") : out.front().reason;
     log::info("frf: stability not analysed: " + s["reason"].get<std::string>());
-    return out;
+    return;
   }
-  s["method"] = "hill";
-  bool imaginary = false;
-  for (const auto& f : out)
-    imaginary = imaginary || (f.available && f.selection == forced::ExponentSelection::imaginary);
-  s["selection"] = imaginary ? "imaginary" : "symmetry";
-  s["neutral_tolerance"] = forced::kNeutralTolerance;
-  s["hill_size"] = size;
+  s["method"] = method;
+  if (method == "hill") {
+    bool imaginary = false;
+    for (const auto& f : out)
+      imaginary = imaginary || (f.available && f.selection == forced::ExponentSelection::imaginary);
+    s["selection"] = imaginary ? "imaginary" : "symmetry";
+    s["neutral_tolerance"] = forced::kNeutralTolerance;
+    s["hill_size"] = size;
+  } else {
+    s["neutral_tolerance"] = forced::kShootingNeutral;
+  }
   s["unstable_points"] = unstable;
   s["failed_points"] = failed;
   if (failed > 0) s["failure"] = failure;
@@ -145,10 +222,51 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
                             {"frequency_hz", c.frequency_hz},
                             {"amplitude_m", c.amplitude_m},
                             {"piece", response.piece[c.point]}});
+  log::info("frf: stability (" +
+            (method == "hill" ? "Hill, " + std::to_string(size) + " exponents per point"
+                              : "shooting, " + std::to_string(s["state_size"].get<int>()) + " multipliers per point") +
+            "): " + std::to_string(unstable) + " of " + std::to_string(out.size()) + " points unstable, " +
+            std::to_string(s["changes"].size()) + " changes of stability" +
+            (failed ? ", " + std::to_string(failed) + " points not analysed" : ""));
+}
+
+/// The stability of every point and run.json's frf.stability. A lumped model with friction is
+/// judged by shooting (its slider memory is part of the time integration's state), with Hill's
+/// verdicts counted against it (docs/physics.md section 9); every other model by Hill.
+std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
+                                                     forced::ReducedEquations& equations,
+                                                     const hbm::ContactEvaluator& evaluator, contact::Model law,
+                                                     int threads) {
+  const log::Stopwatch clock;
+  auto& s = j["stability"];
+  s = nlohmann::json::object();
+  std::vector<std::string> errors;
+  std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, errors);
+  const auto* lumped = dynamic_cast<const frf::LumpedLinearPart*>(&equations.linear_part());
+  const auto& pairs = evaluator.pairs();
+  const bool friction =
+      std::any_of(pairs.begin(), pairs.end(), [](const auto& p) { return p.friction_coefficient > 0; });
+  if (lumped == nullptr || !friction) {
+    report_stability(s, hill, errors, response, "hill");
+    s["seconds"] = clock.seconds();
+    return hill;
+  }
+  std::vector<std::string> shooting_errors;
+  std::vector<forced::FloquetResult> out =
+      shooting_stability(response, equations, *lumped, pairs, law, threads, shooting_errors, s);
+  report_stability(s, out, shooting_errors, response, "shooting");
+  // Hill's verdicts against the shooting's, where both judged.
+  int hill_unstable = 0, disagree = 0, judged = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (!hill[i].available || !out[i].available) continue;
+    ++judged;
+    hill_unstable += hill[i].stable ? 0 : 1;
+    disagree += hill[i].stable != out[i].stable ? 1 : 0;
+  }
+  s["hill"] = {{"judged_points", judged}, {"unstable_points", hill_unstable}, {"disagreements", disagree}};
+  log::info("frf: Hill's linearization (without the slider memory) disagrees with the shooting at " +
+            std::to_string(disagree) + " of " + std::to_string(judged) + " points");
   s["seconds"] = clock.seconds();
-  log::info("frf: stability (Hill, " + std::to_string(size) + " exponents per point): " + std::to_string(unstable) +
-            " of " + std::to_string(out.size()) + " points unstable, " + std::to_string(s["changes"].size()) +
-            " changes of stability" + (failed ? ", " + std::to_string(failed) + " points not analysed" : ""));
   return out;
 }
 
@@ -292,13 +410,28 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   for (const auto& w : response.warnings) ctx.report.warn(w);
 
   const ReportedPeak peak = reported_peak(response);
+  double max_energy_error = 0.0, worst_energy_f = 0.0;
+  int unconverged = 0;
+  for (const auto& r : results) {
+    if (r.energy_error >= max_energy_error) max_energy_error = r.energy_error, worst_energy_f = r.frequency_hz;
+    unconverged += r.unconverged_pairs;
+  }
+  // A point whose excitation work and dissipation disagree is not a solution of the
+  // mechanics, whatever the residual says (e.g. a contact law that did not reach its periodic
+  // state): the run fails its own check (docs/continuation.md).
+  const bool energy_failed = max_energy_error > c.hbm.energy_tolerance;
   std::vector<forced::FloquetResult> stability;
   const std::string refusal = sector_stability_refusal(c);
-  if (c.response.stability && refusal.empty()) {
-    stability = analyse_stability(j, response, equations, ctx.threads);
-  } else if (c.response.stability) {
+  if (c.response.stability && !refusal.empty()) {
     j["stability"] = {{"available", false}, {"reason", refusal}};
     log::info("frf: stability " + refusal);
+  } else if (c.response.stability && (energy_failed || branch.status != continuation::BranchStatus::kReachedEnd)) {
+    // A curve that fails its checks is not the result (a raised N or another trial may be;
+    // docs/contract.md): its points are not judged, which on a lumped model with friction
+    // (shooting) would cost more than the curve.
+    j["stability"] = {{"available", false}, {"reason", "the curve did not pass its checks; its points are not judged"}};
+  } else if (c.response.stability) {
+    stability = analyse_stability(j, response, equations, evaluator, eo.law.model, ctx.threads);
   }
   const bool analysed = c.response.stability && j["stability"]["available"].get<bool>();
   write_frf_csv(ctx.out_dir / "frf.csv", response, c.hbm.harmonics, analysed ? &stability : nullptr);
@@ -308,12 +441,6 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   write_peaks_csv(ctx.out_dir / "peaks.csv", response);
   if (c.response.shapes && ctx.plots) write_shapes(ctx, model, evaluator, equations, response);
 
-  double max_energy_error = 0.0, worst_energy_f = 0.0;
-  int unconverged = 0;
-  for (const auto& r : results) {
-    if (r.energy_error >= max_energy_error) max_energy_error = r.energy_error, worst_energy_f = r.frequency_hz;
-    unconverged += r.unconverged_pairs;
-  }
   report_branch(j, response, equations, evaluator.n_pairs());
   j["max_energy_balance_error"] = max_energy_error;
   j["peak_amplitude_m"] = peak.amplitude_m;
@@ -323,10 +450,6 @@ ForcedResponseOutcome trace_case(Context& ctx) {
   if (unconverged > 0)
     ctx.report.warn(std::to_string(unconverged) +
                     " contact evaluations did not reach a periodic state within the period cap");
-  // A point whose excitation work and dissipation disagree is not a solution of the
-  // mechanics, whatever the residual says (e.g. a contact law that did not reach its periodic
-  // state): the run fails its own check (docs/continuation.md).
-  const bool energy_failed = max_energy_error > c.hbm.energy_tolerance;
   j["energy_check_passed"] = !energy_failed;
   j["polished_points"] = response.polished_points;
   std::ostringstream s;

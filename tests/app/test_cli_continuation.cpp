@@ -647,6 +647,7 @@ TEST(CliContinuation, TheMiddleBranchBetweenTwoFoldsIsReportedUnstable) {
   ASSERT_TRUE(frf.contains("stability"));
   const auto& st = frf["stability"];
   EXPECT_TRUE(st["available"].get<bool>());
+  EXPECT_EQ(st["method"].get<std::string>(), "hill");  // no friction: a memoryless law
   EXPECT_EQ(st["failed_points"].get<int>(), 0);
   ASSERT_EQ(st["changes"].size(), 2u);
   for (const auto& c : st["changes"]) EXPECT_EQ(c["kind"].get<std::string>(), "fold");
@@ -663,6 +664,76 @@ TEST(CliContinuation, TheMiddleBranchBetweenTwoFoldsIsReportedUnstable) {
   EXPECT_GT(unstable, 10);
   // All but the points next to the folds (at most two at each) step backwards.
   EXPECT_GE(backwards_unstable, unstable - 4);
+}
+
+/// Stress corpus model 8 (3 DOFs, quasi3d friction, H = 15, N = 128) with time rescaled by s:
+/// mass s^2, damping s, frequencies / s.
+std::string model_8(double s) {
+  std::ostringstream c;
+  c.precision(17);
+  const double m[3] = {1.6066451485192936, 3.1022110663309252, 2.111869185489189};
+  const double k[3][3] = {{7.043627933089065, 2.534038191691849, -1.3796205878592054},
+                          {2.534038191691849, 3.712810230293924, 1.5670428633530467},
+                          {-1.3796205878592054, 1.5670428633530467, 3.0050000077515504}};
+  const double d[3][3] = {{0.44199958292165586, 0.15901518854703842, -0.08657352861573811},
+                          {0.15901518854703842, 0.23298513051035977, 0.098334593848804},
+                          {-0.08657352861573811, 0.098334593848804, 0.18856884019472284}};
+  const auto matrix = [&](const double(*a)[3], double f) {
+    std::ostringstream o;
+    o.precision(17);
+    o << "[";
+    for (int i = 0; i < 3; ++i) {
+      o << (i ? ", [" : "[");
+      for (int j = 0; j < 3; ++j) o << (j ? ", " : "") << a[i][j] * f;
+      o << "]";
+    }
+    o << "]";
+    return o.str();
+  };
+  const double mass[3][3] = {{m[0], 0, 0}, {0, m[1], 0}, {0, 0, m[2]}};
+  c << "name = \"stress_0008\"\n[structure]\ntype = \"lumped\"\nsectors = 1\nmass = " << matrix(mass, s * s)
+    << "\nstiffness = " << matrix(k, 1.0) << "\ndamping = " << matrix(d, s)
+    << "\n[excitation]\nforce = 1.1286367840819407\ndof = 1\n[response]\ndof = 2\n"
+       "[contact]\nmodel = \"quasi3d\"\nfriction_coefficient = 0.28024622979545577\n"
+       "tangential_stiffness = 17.127970366335703\nnormal_stiffness = 4.789290774238505\n"
+       "normal_preload = 8.532175357752111\n[[contact.elements]]\nx_dof = 0\ny_dof = 1\nz_dof = 2\n"
+       "[hbm]\nharmonics = 15\ntime_samples = 128\n[continuation]\nfrequency_start_hz = "
+    << 0.053803261612576106 / s << "\nfrequency_end_hz = " << 0.1156911635999745 / s << "\n";
+  return c.str();
+}
+
+TEST(CliContinuation, ALumpedFrictionModelIsJudgedByShootingTheSameAtAnyTimeScaleAndThreadCount) {
+  // Hill's linearization drops the friction slider's memory and calls stretches of this curve
+  // unstable where the time integration from rest settles on it (forced.Shooting tests); the
+  // shooting on the time integration calls every point stable. The verdicts are a property of
+  // the motion: the same with time rescaled by 1e-3, and with 1 or 2 threads.
+  const Scratch s("shooting");
+  std::vector<std::vector<std::vector<std::string>>> tables;
+  for (double scale : {1.0, 1e-3}) {
+    const std::string name = scale == 1.0 ? "case_1" : "case_2";
+    s.write(name + ".toml", model_8(scale));
+    const CliResult r = s.run("frf " + name + ".toml --quiet --threads 2 --out " + name);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto frf = frf_of(s, name);
+    const auto& st = frf["stability"];
+    EXPECT_EQ(st["method"].get<std::string>(), "shooting");
+    EXPECT_EQ(st["failed_points"].get<int>(), 0);
+    EXPECT_EQ(st["unstable_points"].get<int>(), 0);
+    const auto rows = csv_rows(slurp(s.dir() / name / "frf.csv"));
+    ASSERT_GT(rows.size(), 100u);
+    ASSERT_EQ(rows[0].back(), "stable");
+    for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_EQ(rows[i].back(), "1") << "row " << i;
+    // Hill's verdicts on the same points are counted against the shooting's.
+    EXPECT_EQ(st["hill"]["judged_points"].get<std::size_t>(), rows.size() - 1);
+    EXPECT_EQ(st["hill"]["disagreements"].get<int>(), st["hill"]["unstable_points"].get<int>());
+    tables.push_back(rows);
+    if (scale == 1.0) {
+      const CliResult r1 = s.run("frf " + name + ".toml --quiet --threads 1 --out " + name + "_t1");
+      ASSERT_EQ(r1.status, 0) << r1.err;
+      EXPECT_EQ(slurp(s.dir() / name / "frf.csv"), slurp(s.dir() / (name + "_t1") / "frf.csv"));
+    }
+  }
+  EXPECT_EQ(tables[0].size(), tables[1].size());
 }
 
 }  // namespace

@@ -4,7 +4,11 @@
 // on the period map of a fine Runge-Kutta integration, its monodromy by central differences)
 // on a hardening gap oscillator with a fold pair, the branch geometry (the stretch between two
 // folds, traced backwards in frequency, is the unstable one), and a time integration of a friction
-// model with three coexisting solutions (it settles on the stable one).
+// model with three coexisting solutions (it settles on the stable one). And the shooting on the
+// time integration (forced/shooting.hpp), which judges the lumped models with friction: the
+// same closed form, the same three solutions, and the points of a friction model that Hill's
+// linearization (without the slider's memory) calls unstable while the integration from rest
+// settles on them.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -18,6 +22,7 @@
 #include <string>
 
 #include "forced/frequency_response.hpp"
+#include "forced/shooting.hpp"
 #include "forced/stability.hpp"
 #include "forced/time_march.hpp"
 #include "frf/lumped.hpp"
@@ -32,6 +37,20 @@ struct Lumped {
   hbm::ContactEvaluatorOptions options;
   double f_start = 0.0, f_end = 0.0;
 };
+
+/// The model's curve over its range, with default continuation settings.
+FrequencyResponse trace_whole_range(const Lumped& l, ReducedEquations& eq) {
+  FrequencyResponseSettings settings;
+  settings.frequency_start_hz = l.f_start;
+  settings.frequency_end_hz = l.f_end;
+  return trace_frequency_response(settings, l.model, l.options, eq);
+}
+
+/// Its equations of motion, for the time integration and the shooting.
+LumpedSystem system_of(const Lumped& l) {
+  const auto& lin = static_cast<const frf::LumpedLinearPart&>(*l.model.linear);
+  return {lin.mass(), lin.damping(), lin.stiffness(), lin.contact_operator(), lin.force_vector()};
+}
 
 /// The 2-DOF chain M = s^2 I, K = [[2, -1], [-1, 2]], C = 0.02 s K with a Jenkins element on
 /// DOF 0 (kt = 1) whose friction limit mu N0 is far above any force it sees: it stays stuck,
@@ -142,6 +161,19 @@ Eigen::Vector2d gap_state_at_zero(const ReducedEquations& eq, const Eigen::Vecto
   return x;
 }
 
+/// The stuck chain's damped eigenvalues in closed form: s^2 M + s C + K + kt e0 e0^T = 0 as a
+/// 4 x 4 companion eigenproblem.
+Eigen::VectorXcd stuck_eigenvalues(const Lumped& l) {
+  const auto& lin = static_cast<const frf::LumpedLinearPart&>(*l.model.linear);
+  Eigen::MatrixXd kk = lin.stiffness();
+  kk(0, 0) += 1.0;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(4, 4);
+  a.topRightCorner(2, 2).setIdentity();
+  a.bottomLeftCorner(2, 2) = -lin.mass().inverse() * kk;
+  a.bottomRightCorner(2, 2) = -lin.mass().inverse() * lin.damping();
+  return Eigen::EigenSolver<Eigen::MatrixXd>(a).eigenvalues();
+}
+
 TEST(Stability, AStuckContactHasTheDampedEigenvaluesOfTheStuckSystemAtAnyTimeScale) {
   for (double s : {1e-3, 1.0, 1e3}) {
     Lumped l = stuck_chain(s);
@@ -153,15 +185,7 @@ TEST(Stability, AStuckContactHasTheDampedEigenvaluesOfTheStuckSystemAtAnyTimeSca
     st.frequency_start_hz = 0.8 / (2 * kPi * s);
     st.frequency_end_hz = 1.4 / (2 * kPi * s);
     ASSERT_GE(continuation::newton_fixed(eq, w, f, arclength_options(st, l.model, eq)), 0);
-    // Closed form: s^2 M + s C + K + kt e0 e0^T = 0 as a 4 x 4 companion eigenproblem.
-    const auto& lin = static_cast<const frf::LumpedLinearPart&>(*l.model.linear);
-    Eigen::MatrixXd kk = lin.stiffness();
-    kk(0, 0) += 1.0;
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(4, 4);
-    a.topRightCorner(2, 2).setIdentity();
-    a.bottomLeftCorner(2, 2) = -lin.mass().inverse() * kk;
-    a.bottomRightCorner(2, 2) = -lin.mass().inverse() * lin.damping();
-    const Eigen::VectorXcd exact = Eigen::EigenSolver<Eigen::MatrixXd>(a).eigenvalues();
+    const Eigen::VectorXcd exact = stuck_eigenvalues(l);
     const double omega = 2 * kPi * f;
     for (ExponentSelection sel : {ExponentSelection::symmetry, ExponentSelection::imaginary}) {
       const FloquetResult r = floquet_exponents(eq, w, f, sel);
@@ -203,10 +227,7 @@ TEST(Stability, HillAgreesWithShootingOnAHardeningGapOscillatorWithAFoldPair) {
   Lumped l = gap_oscillator();
   hbm::ContactEvaluator ev(l.options, l.model.pairs);
   ReducedEquations eq(*l.model.linear, ev);
-  FrequencyResponseSettings settings;
-  settings.frequency_start_hz = l.f_start;
-  settings.frequency_end_hz = l.f_end;
-  const FrequencyResponse r = trace_frequency_response(settings, l.model, l.options, eq);
+  const FrequencyResponse r = trace_whole_range(l, eq);
   ASSERT_EQ(r.summary.status, continuation::BranchStatus::kReachedEnd) << r.summary.message;
   // Every point: Hill's verdict; about 12 of them spread over the curve: shooting's.
   std::vector<FloquetResult> hill;
@@ -309,12 +330,8 @@ TEST(Stability, WhereFrictionGivesSeveralSolutionsTheTimeIntegrationSettlesOnASt
   Lumped l = model_105();
   hbm::ContactEvaluator ev(l.options, l.model.pairs);
   ReducedEquations eq(*l.model.linear, ev);
-  FrequencyResponseSettings settings;
-  settings.frequency_start_hz = l.f_start;
-  settings.frequency_end_hz = l.f_end;
-  const FrequencyResponse r = trace_frequency_response(settings, l.model, l.options, eq);
-  const auto& lin = static_cast<const frf::LumpedLinearPart&>(*l.model.linear);
-  const LumpedSystem system{lin.mass(), lin.damping(), lin.stiffness(), lin.contact_operator(), lin.force_vector()};
+  const FrequencyResponse r = trace_whole_range(l, eq);
+  const LumpedSystem system = system_of(l);
   // At 770 and 780 Hz the curve has three solutions (the branch from 545 Hz and two on the loop
   // above it). Integrated in time from rest, the motion settles on the one Hill's method calls
   // stable (measured 1.6 % from it: the sampled law at N = 64 against the time-continuous one,
@@ -344,6 +361,160 @@ TEST(Stability, WhereFrictionGivesSeveralSolutionsTheTimeIntegrationSettlesOnASt
     EXPECT_EQ(stable, 1) << "f = " << f;
     EXPECT_GE(unstable, 2) << "f = " << f;
   }
+}
+
+/// The shooting's state at t = 0 of the solution w, and its result.
+ShootingResult shoot(ReducedEquations& eq, const Lumped& l, const Eigen::VectorXd& w, double f) {
+  const LumpedSystem system = system_of(l);
+  const auto& lin = static_cast<const frf::LumpedLinearPart&>(*l.model.linear);
+  Eigen::VectorXd u0, v0, d0;
+  harmonic_balance_state(eq, lin, l.model.pairs, l.options.law.model, w, f, u0, v0, d0);
+  return shooting_floquet(system, l.model.pairs, l.options.law.model, f, u0, v0, d0);
+}
+
+TEST(Shooting, AStuckContactHasTheDampedMultipliersOfTheStuckSystemAndANeutralSliderAtAnyTimeScale) {
+  for (double s : {1e-3, 1.0, 1e3}) {
+    Lumped l = stuck_chain(s);
+    hbm::ContactEvaluator ev(l.options, l.model.pairs);
+    ReducedEquations eq(*l.model.linear, ev);
+    const double f = 1.1 / (2 * kPi * s);
+    Eigen::VectorXd w = eq.stuck_solution(f);
+    FrequencyResponseSettings st;
+    st.frequency_start_hz = 0.8 / (2 * kPi * s);
+    st.frequency_end_hz = 1.4 / (2 * kPi * s);
+    ASSERT_GE(continuation::newton_fixed(eq, w, f, arclength_options(st, l.model, eq)), 0);
+    const ShootingResult r = shoot(eq, l, w, f);
+    ASSERT_TRUE(r.available) << r.reason;
+    EXPECT_TRUE(r.stable);
+    // The harmonic balance of a linear system is exact at any H: the state it gives is the
+    // integration's periodic orbit but for the scheme's O(dt^2) error.
+    constexpr double kSchemeError = 1e-4;
+    EXPECT_LT(r.start_mismatch, kSchemeError) << "s = " << s;
+    ASSERT_EQ(r.state_size, 5);  // u, v of 2 DOFs and one slider
+    ASSERT_EQ(r.multipliers.size(), 5u);
+    // Closed form: exp(lambda T) of the stuck chain's eigenvalues, and 1 for the stuck slider
+    // (a shifted anchor gives another periodic orbit). The explicit scheme's error over a
+    // period at 4096 steps: a relative frequency error (w_max dt)^2 / 24 ~ 2.5e-7 times
+    // w_max T = 2 pi 1.73 / 1.1, ~3e-6 (measured 4.3e-5 at 1024 steps, 16 times more); the
+    // slider's 1 is exact but for the forward differences' round-off.
+    const Eigen::VectorXcd exact = stuck_eigenvalues(l);
+    constexpr double kMultiplierTol = 1e-5, kNeutralTol = 1e-7;
+    for (Eigen::Index j = 0; j < exact.size(); ++j) {
+      const std::complex<double> mu = std::exp(exact[j] / f);
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& m : r.multipliers) nearest = std::min(nearest, std::abs(m - mu));
+      EXPECT_LT(nearest, kMultiplierTol) << "s = " << s << " multiplier " << mu;
+    }
+    double neutral = std::numeric_limits<double>::infinity();
+    for (const auto& m : r.multipliers) neutral = std::min(neutral, std::abs(m - 1.0));
+    EXPECT_LT(neutral, kNeutralTol) << "s = " << s;
+  }
+}
+
+TEST(Shooting, WhereFrictionGivesSeveralSolutionsItCallsStableTheOneTheTimeIntegrationSettlesOn) {
+  Lumped l = model_105();
+  hbm::ContactEvaluator ev(l.options, l.model.pairs);
+  ReducedEquations eq(*l.model.linear, ev);
+  const FrequencyResponse r = trace_whole_range(l, eq);
+  const LumpedSystem system = system_of(l);
+  constexpr double kSameMotion = 0.05, kOtherMotion = 0.5;  // as for Hill above
+  for (double f : {770.0, 780.0}) {
+    const auto solutions = solutions_at_frequency(r, eq, f);
+    ASSERT_GE(solutions.size(), 3u) << "f = " << f;
+    TimeMarchOptions to;
+    to.output_samples = l.options.n_time_samples;
+    const TimeMarchResult tm = march_to_steady_state(system, l.model.pairs, l.options.law.model, f, to);
+    ASSERT_EQ(tm.motion, TimeMarchResult::Motion::periodic) << tm.describe();
+    const Eigen::VectorXd wm = harmonic_unknowns(tm.contact_motion, l.options.n_harmonics, 3);
+    // The other two are 2.2 to 4.6 away (relative): at H = 4, N = 64 they lie on a loop of the
+    // sampled law, and the time integration has no periodic orbit near them (their state's
+    // mismatch over one period is above 1); they are either not judged or unstable.
+    int stable = 0, others = 0;
+    for (const auto& w : solutions) {
+      const ShootingResult sh = shoot(eq, l, w, f);
+      const double d = (w - wm).norm() / wm.norm();
+      if (d < kSameMotion) {
+        ASSERT_TRUE(sh.available) << sh.reason;
+        EXPECT_TRUE(sh.stable) << "f = " << f << " spectral radius " << sh.spectral_radius;
+        ++stable;
+      } else {
+        EXPECT_GT(d, kOtherMotion) << "f = " << f;
+        EXPECT_TRUE(!sh.available || !sh.stable) << "f = " << f;
+        if (!sh.available) {
+          EXPECT_NE(sh.reason.find("no periodic orbit"), std::string::npos) << sh.reason;
+        }
+        ++others;
+      }
+    }
+    EXPECT_EQ(stable, 1) << "f = " << f;
+    EXPECT_GE(others, 2) << "f = " << f;
+  }
+}
+
+/// Stress corpus model 8 (3 DOFs, quasi3d friction, H = 15, N = 128): Hill's linearization
+/// calls stretches of its curve unstable.
+Lumped model_8() {
+  Lumped l;
+  Eigen::MatrixXd m(3, 3), k(3, 3), c(3, 3);
+  m << 1.6066451485192936, 0, 0, 0, 3.1022110663309252, 0, 0, 0, 2.111869185489189;
+  k << 7.043627933089065, 2.534038191691849, -1.3796205878592054, 2.534038191691849, 3.712810230293924,
+      1.5670428633530467, -1.3796205878592054, 1.5670428633530467, 3.0050000077515504;
+  c << 0.44199958292165586, 0.15901518854703842, -0.08657352861573811, 0.15901518854703842, 0.23298513051035977,
+      0.098334593848804, -0.08657352861573811, 0.098334593848804, 0.18856884019472284;
+  frf::LumpedContact e;
+  e.dof = {0, 1, 2};
+  l.model.linear =
+      std::make_unique<frf::LumpedLinearPart>(m, k, c, std::vector<frf::LumpedContact>{e}, 1, 1.1286367840819407, 2);
+  contact::PairParameters p;
+  p.friction_coefficient = 0.28024622979545577;
+  p.tangential_stiffness = 17.127970366335703;
+  p.normal_stiffness = 4.789290774238505;
+  p.normal_preload = 8.532175357752111;
+  l.model.pairs = {p};
+  l.options.n_harmonics = 15;
+  l.options.n_time_samples = 128;
+  l.options.law.model = contact::Model::quasi3d;
+  l.options.threads = 1;
+  l.options.measure_plans = false;
+  l.f_start = 0.053803261612576106;
+  l.f_end = 0.1156911635999745;
+  return l;
+}
+
+TEST(Shooting, PointsHillCallsUnstableWhereTheTimeIntegrationSettlesAreStable) {
+  Lumped l = model_8();
+  hbm::ContactEvaluator ev(l.options, l.model.pairs);
+  ReducedEquations eq(*l.model.linear, ev);
+  const FrequencyResponse r = trace_whole_range(l, eq);
+  ASSERT_EQ(r.summary.status, continuation::BranchStatus::kReachedEnd);
+  const LumpedSystem system = system_of(l);
+  // Four points spread over the stretches Hill calls unstable; at each the integration from
+  // rest settles on the harmonic-balance solution (the sampled law at N = 128 against the
+  // time-continuous one: measured 2e-4 at 0.0613 and 0.0690 Hz), so the solution attracts and
+  // the shooting must call it stable.
+  std::vector<std::size_t> hill_unstable;
+  for (std::size_t i = 0; i < r.points.size(); ++i)
+    if (!floquet_exponents(eq, r.points[i].x, r.points[i].lambda).stable) hill_unstable.push_back(i);
+  ASSERT_GE(hill_unstable.size(), 4u) << "Hill's linearization no longer calls this curve unstable anywhere: "
+                                         "the test's premise is gone";
+  constexpr double kSettledOnIt = 1e-2;
+  int checked = 0;
+  for (int q = 0; q < 4; ++q) {
+    const std::size_t i = hill_unstable[q * (hill_unstable.size() - 1) / 3];
+    const double f = r.points[i].lambda;
+    TimeMarchOptions to;
+    to.output_samples = l.options.n_time_samples;
+    const TimeMarchResult tm = march_to_steady_state(system, l.model.pairs, l.options.law.model, f, to);
+    if (tm.motion != TimeMarchResult::Motion::periodic) continue;
+    const Eigen::VectorXd wm = harmonic_unknowns(tm.contact_motion, l.options.n_harmonics, 3);
+    const double d = (r.points[i].x - wm).norm() / wm.norm();
+    if (d > kSettledOnIt) continue;  // another solution attracts here: nothing to conclude
+    ++checked;
+    const ShootingResult sh = shoot(eq, l, r.points[i].x, f);
+    ASSERT_TRUE(sh.available) << sh.reason;
+    EXPECT_TRUE(sh.stable) << "f = " << f << " spectral radius " << sh.spectral_radius;
+  }
+  EXPECT_GE(checked, 2);
 }
 
 }  // namespace

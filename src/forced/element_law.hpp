@@ -1,0 +1,75 @@
+#pragma once
+// The contact law of one element in continuous time, shared by the time integration
+// (forced/time_march.hpp) and the shooting (forced/shooting.hpp): docs/physics.md section 4
+// without the sampling of the period.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "contact/contact_law.hpp"
+
+namespace shroudsim::forced::detail {
+
+// The step is far below the stick and slip time scales, so the slider update of the
+// sampled law ("radial_return") is exact to O(dt).
+struct ElementLaw {
+  contact::PairParameters p;
+  bool one_d = false, coupled = true;
+
+  // w: x, y, z of the element; d: slider (x, y), updated; f: force (Tx, Ty, N).
+  void force(const double* w, double* d, double* f) const {
+    const double kt = p.tangential_stiffness, mu = p.friction_coefficient;
+    const double n = one_d ? std::max(0.0, p.normal_preload)
+                           : std::max(0.0, p.normal_preload + p.normal_stiffness * w[2]);
+    f[2] = one_d ? 0.0 : n;
+    if (!(n > 0.0)) {  // separated: no force, the slider follows
+      d[0] = w[0];
+      d[1] = one_d ? 0.0 : w[1];
+      f[0] = f[1] = 0.0;
+      return;
+    }
+    const double limit = mu * n;
+    if (one_d || !coupled) {
+      for (int k = 0; k < (one_d ? 1 : 2); ++k) {
+        const double t = kt * (w[k] - d[k]);
+        if (std::abs(t) <= limit) {
+          f[k] = t;
+        } else {
+          f[k] = std::copysign(limit, t);
+          d[k] = w[k] - f[k] / kt;
+        }
+      }
+      if (one_d) f[1] = 0.0;
+      return;
+    }
+    const double tx = kt * (w[0] - d[0]), ty = kt * (w[1] - d[1]);
+    const double t = std::hypot(tx, ty);
+    if (t <= limit) {
+      f[0] = tx;
+      f[1] = ty;
+    } else {
+      f[0] = limit * tx / t;
+      f[1] = limit * ty / t;
+      d[0] = w[0] - f[0] / kt;
+      d[1] = w[1] - f[1] / kt;
+    }
+  }
+};
+
+/// The explicit scheme's step options, as the time integration and the shooting both take them:
+/// appends one message per violated constraint; true when valid.
+inline bool valid_steps(int min_steps_per_period, double steps_per_stiff_period, std::vector<std::string>* errors) {
+  bool ok = true;
+  if (min_steps_per_period < 16) {
+    ok = false;
+    if (errors) errors->push_back("min_steps_per_period >= 16");
+  }
+  if (!(steps_per_stiff_period >= 8.0) || !std::isfinite(steps_per_stiff_period)) {
+    ok = false;
+    if (errors) errors->push_back("steps_per_stiff_period >= 8 (the scheme is unstable from pi steps on)");
+  }
+  return ok;
+}
+
+}  // namespace shroudsim::forced::detail
