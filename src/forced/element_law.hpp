@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "contact/contact_law.hpp"
 
 namespace shroudsim::forced::detail {
@@ -56,6 +58,22 @@ struct ElementLaw {
     }
   }
 };
+
+/// The forces the structure already carries (contact.normal_preload = "static"), per contact
+/// row (x, y, z of each element): max(0, N0) normal, for the 3D laws.
+inline Eigen::VectorXd static_load(const std::vector<contact::PairParameters>& pairs, bool one_d) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(pairs.size()));
+  for (std::size_t e = 0; e < pairs.size(); ++e)
+    if (pairs[e].preload_in_equilibrium && !one_d)
+      f[3 * static_cast<Eigen::Index>(e) + 2] = std::max(0.0, pairs[e].normal_preload);
+  return f;
+}
+
+/// The steps one excitation period needs: at least min_steps_per_period, and
+/// steps_per_stiff_period per period of the stuck system's highest mode w_max [rad/s].
+inline double steps_needed(int min_steps_per_period, double steps_per_stiff_period, double w_max, double w) {
+  return std::max(static_cast<double>(min_steps_per_period), steps_per_stiff_period * w_max / w);
+}
 
 /// The explicit scheme's step options, as the time integration and the shooting both take them:
 /// appends one message per violated constraint; true when valid.

@@ -263,8 +263,7 @@ bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluator
                            const Info& info) {
   const auto* lumped = dynamic_cast<const frf::LumpedLinearPart*>(model.linear.get());
   if (lumped == nullptr) return false;
-  const LumpedSystem system{lumped->mass(), lumped->damping(), lumped->stiffness(), lumped->contact_operator(),
-                            lumped->force_vector()};
+  const LumpedSystem system = lumped_system(*lumped);
   TimeMarchOptions to;
   to.output_samples = std::max(eo.n_time_samples, kMarchOutputSamples);
   bool reused = false;

@@ -19,15 +19,6 @@ namespace {
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kNewtonStall = 0.5;
 
-/// The forces the structure already carries (contact.normal_preload = "static"), per contact row.
-Eigen::VectorXd static_load(const std::vector<contact::PairParameters>& pairs, bool one_d) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(pairs.size()));
-  for (std::size_t e = 0; e < pairs.size(); ++e)
-    if (pairs[e].preload_in_equilibrium && !one_d)
-      f[3 * static_cast<Eigen::Index>(e) + 2] = std::max(0.0, pairs[e].normal_preload);
-  return f;
-}
-
 /// One excitation period of the explicit scheme of forced/time_march.cpp, applied to several
 /// states at once (the columns of a matrix: the forward differences march together). A state
 /// is z = (u, v / w, sliders), the sliders one per tangential direction of each element.
@@ -46,7 +37,7 @@ class PeriodMap {
     a_damping_ = lhs.solve(s.damping);
     a_contact_ = lhs.solve(s.contact_operator.transpose());
     mass_llt_.compute(s.mass);
-    f_static_ = static_load(pairs, one_d_);
+    f_static_ = detail::static_load(pairs, one_d_);
     excitation_.resize(steps);
     for (long long k = 0; k < steps; ++k) excitation_[k] = std::cos(w_ * static_cast<double>(k + 1) * dt_);
   }
@@ -175,8 +166,7 @@ ShootingResult shooting_floquet(const LumpedSystem& s, const std::vector<contact
   }
   const double w = kTwoPi * frequency_hz;
   const double w_max = stuck_highest_circular_frequency(s, pairs, model);
-  const double steps_needed =
-      std::max(static_cast<double>(o.min_steps_per_period), o.steps_per_stiff_period * w_max / w);
+  const double steps_needed = detail::steps_needed(o.min_steps_per_period, o.steps_per_stiff_period, w_max, w);
   if (steps_needed > static_cast<double>(o.max_steps_per_period)) {
     r.reason = "one period needs " + std::to_string(static_cast<long long>(std::ceil(steps_needed))) +
                " steps (stiff contact against a slow excitation; the limit is " +
@@ -202,11 +192,13 @@ ShootingResult shooting_floquet(const LumpedSystem& s, const std::vector<contact
   // taken at the final z. A stuck slider makes M - I singular (a neutral direction: any anchor
   // gives an orbit): the least-squares step of the complete orthogonal decomposition. The
   // monodromy is reused (a chord step) while it halves the mismatch, and taken afresh when not.
-  const auto newton = [&](Eigen::VectorXd& x) {
+  // `start`, when given, gets the mismatch at x itself.
+  const auto newton = [&](Eigen::VectorXd& x, double* start) {
     const Eigen::VectorXd x0 = x;
     Eigen::VectorXd px = map_and_derivative(map, x, monodromy);
     bool fresh = true;
     double mismatch = px.allFinite() ? mismatch_of(px, x) : INFINITY;
+    if (start) *start = mismatch;
     Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
     cod.setThreshold(1e-10);
     cod.compute(monodromy - Eigen::MatrixXd::Identity(x.size(), x.size()));
@@ -244,11 +236,7 @@ ShootingResult shooting_floquet(const LumpedSystem& s, const std::vector<contact
     if (!fresh && mismatch_of(x, x0) > kShootingReuse) px = map_and_derivative(map, x, monodromy);
     return mismatch;
   };
-  {
-    const Eigen::VectorXd pz = map.apply(z);
-    r.start_mismatch = pz.allFinite() ? mismatch_of(pz, z) : INFINITY;
-  }
-  r.mismatch = newton(z);
+  r.mismatch = newton(z, &r.start_mismatch);
   if (!(r.mismatch <= kShootingMismatch) && std::isfinite(r.mismatch)) {
     // The period map is piecewise smooth (stick-slip, lift-off, and the step's quantization of
     // their instants), and Newton can stall between its pieces. Then the motion decides: marched
@@ -284,7 +272,7 @@ ShootingResult shooting_floquet(const LumpedSystem& s, const std::vector<contact
     // Settled: the orbit there attracts; its multipliers from Newton on it.
     z = x;
     r.settled = true;
-    r.mismatch = newton(z);
+    r.mismatch = newton(z, nullptr);
     if (!(r.mismatch <= kShootingMismatch)) r.mismatch = change;
   }
   if (!(r.mismatch <= kShootingMismatch)) {
@@ -315,10 +303,9 @@ ShootingResult shooting_floquet(const LumpedSystem& s, const std::vector<contact
 double shooting_work(const LumpedSystem& s, const std::vector<contact::PairParameters>& pairs, contact::Model model,
                      double frequency_hz, const ShootingOptions& o) {
   const double w = kTwoPi * frequency_hz;
-  const double steps =
-      std::min(static_cast<double>(o.max_steps_per_period),
-               std::max(static_cast<double>(o.min_steps_per_period),
-                        o.steps_per_stiff_period * stuck_highest_circular_frequency(s, pairs, model) / w));
+  const double steps = std::min(static_cast<double>(o.max_steps_per_period),
+                                detail::steps_needed(o.min_steps_per_period, o.steps_per_stiff_period,
+                                                     stuck_highest_circular_frequency(s, pairs, model), w));
   if (!std::isfinite(steps)) return 0.0;  // no positive-definite mass: shooting_floquet declines at once
   const double d = 2.0 * static_cast<double>(s.mass.rows()) +
                    (contact::n_directions(model) == 1 ? 1.0 : 2.0) * static_cast<double>(pairs.size());
@@ -336,7 +323,7 @@ void harmonic_balance_state(ReducedEquations& equations, const frf::LumpedLinear
   const Eigen::Index n = lumped.mass().rows();
   u0 = Eigen::VectorXd::Zero(n);
   v0 = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd f0 = static_load(pairs, one_d);
+  Eigen::VectorXd f0 = detail::static_load(pairs, one_d);
   for (std::size_t h = 0; h < forces.size(); ++h) {
     // x(t) = Re sum_h X_h e^{i h w t}: at t = 0 Re X_h, and the velocity Re(i h w X_h).
     const Eigen::VectorXcd u = lumped.displacement(static_cast<int>(h), omega, forces[h]);

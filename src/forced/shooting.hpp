@@ -80,8 +80,8 @@ struct ShootingResult {
   bool available = false;
   std::string reason;  ///< why not available
   bool stable = true;
-  /// The monodromy's eigenvalues, by decreasing modulus (empty when the motion left the solution) (zero ones included:
-  /// sliders that slip forget their anchor).
+  /// The monodromy's eigenvalues, by decreasing modulus, zero ones included (sliders that slip
+  /// forget their anchor); empty when the motion left the solution.
   std::vector<std::complex<double>> multipliers;
   double spectral_radius = 0.0;
   double start_mismatch = 0.0;  ///< |P(z0) - z0| / |z0| at the harmonic-balance state

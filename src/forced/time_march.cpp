@@ -13,6 +13,7 @@
 #include <string>
 
 #include "forced/element_law.hpp"
+#include "frf/lumped.hpp"
 #include "hbm/harmonic_layout.hpp"
 
 namespace shroudsim::forced {
@@ -63,6 +64,10 @@ std::string TimeMarchResult::describe() const {
   return "?";
 }
 
+LumpedSystem lumped_system(const frf::LumpedLinearPart& lumped) {
+  return {lumped.mass(), lumped.damping(), lumped.stiffness(), lumped.contact_operator(), lumped.force_vector()};
+}
+
 double stuck_highest_circular_frequency(const LumpedSystem& s, const std::vector<contact::PairParameters>& pairs,
                                         contact::Model model) {
   const bool one_d = contact::n_directions(model) == 1;
@@ -103,8 +108,7 @@ TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<c
   }
   const double w_max = stuck_highest_circular_frequency(s, pairs, model);
   const double w = kTwoPi * frequency_hz;
-  const double steps_needed =
-      std::max(static_cast<double>(o.min_steps_per_period), o.steps_per_stiff_period * w_max / w);
+  const double steps_needed = detail::steps_needed(o.min_steps_per_period, o.steps_per_stiff_period, w_max, w);
   // A whole number of steps per output sample, so the output falls on steps.
   const long long per_sample = static_cast<long long>(std::ceil(steps_needed / o.output_samples));
   const long long steps = per_sample * o.output_samples;
@@ -118,10 +122,7 @@ TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<c
   const Eigen::PartialPivLU<Eigen::MatrixXd> lhs(s.mass + 0.5 * dt * s.damping);
 
   // Forces the structure already carries (contact.normal_preload = "static").
-  Eigen::VectorXd f_static = Eigen::VectorXd::Zero(c);
-  for (std::size_t e = 0; e < pairs.size(); ++e)
-    if (pairs[e].preload_in_equilibrium && !one_d)
-      f_static[3 * static_cast<Eigen::Index>(e) + 2] = std::max(0.0, pairs[e].normal_preload);
+  const Eigen::VectorXd f_static = detail::static_load(pairs, one_d);
 
   Eigen::VectorXd u = Eigen::VectorXd::Zero(n), v = Eigen::VectorXd::Zero(n), a(n), a1(n), v_half(n), wc(c), fc(c);
   Eigen::VectorXd slider = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(pairs.size()));

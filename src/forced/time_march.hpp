@@ -20,6 +20,10 @@
 
 #include "contact/contact_law.hpp"
 
+namespace shroudsim::frf {
+class LumpedLinearPart;
+}
+
 namespace shroudsim::forced {
 
 /// The lumped equations of motion: f(t) = force cos(w t); contact_operator B (3 rows per
@@ -28,6 +32,9 @@ struct LumpedSystem {
   Eigen::MatrixXd mass, damping, stiffness, contact_operator;
   Eigen::VectorXd force;
 };
+
+/// The equations of motion of a lumped linear part (its M, C, K, B and excitation).
+LumpedSystem lumped_system(const frf::LumpedLinearPart& lumped);
 
 struct TimeMarchOptions {
   int min_steps_per_period = 4096;

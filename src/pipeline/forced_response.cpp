@@ -119,13 +119,7 @@ std::vector<forced::FloquetResult> shooting_stability(const forced::FrequencyRes
                                                       contact::Model law, int threads, std::vector<std::string>& errors,
                                                       nlohmann::json& s) {
   const std::size_t n = response.points.size();
-  const forced::LumpedSystem system{lumped.mass(), lumped.damping(), lumped.stiffness(), lumped.contact_operator(),
-                                    lumped.force_vector()};
-  std::vector<Eigen::VectorXd> u0(n), v0(n), d0(n);
-  // The states from the harmonics in order (the equations are not shared between threads).
-  for (std::size_t i = 0; i < n; ++i)
-    forced::harmonic_balance_state(equations, lumped, pairs, law, response.points[i].x, response.points[i].lambda,
-                                   u0[i], v0[i], d0[i]);
+  const forced::LumpedSystem system = forced::lumped_system(lumped);
   // The work bound (forced::kShootingBudget): every stride-th point of a curve that would
   // exceed it is judged, the others left undecided (the same points at any thread count).
   const forced::ShootingOptions options;
@@ -134,12 +128,19 @@ std::vector<forced::FloquetResult> shooting_stability(const forced::FrequencyRes
     work += forced::shooting_work(system, pairs, law, response.points[i].lambda, options);
   const std::size_t stride =
       std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(work / forced::kShootingBudget)));
+  const auto judged = [&](std::size_t k) { return k % stride == 0 || k + 1 == n; };
+  std::vector<Eigen::VectorXd> u0(n), v0(n), d0(n);
+  // The states from the harmonics in order (the equations are not shared between threads).
+  for (std::size_t i = 0; i < n; ++i)
+    if (judged(i))
+      forced::harmonic_balance_state(equations, lumped, pairs, law, response.points[i].x, response.points[i].lambda,
+                                     u0[i], v0[i], d0[i]);
   std::vector<forced::ShootingResult> shots(n);
   errors.assign(n, std::string());
   const int jobs = static_cast<int>(n);
   linalg::parallel_for(jobs, linalg::worker_count(threads, jobs), [&](int i) {
     const auto k = static_cast<std::size_t>(i);
-    if (k % stride != 0 && k + 1 != n) {
+    if (!judged(k)) {
       shots[k].reason = "not judged: the shooting of every point would exceed its work bound, so every " +
                         std::to_string(stride) + "th point is judged";
       return;

@@ -48,8 +48,7 @@ FrequencyResponse trace_whole_range(const Lumped& l, ReducedEquations& eq) {
 
 /// Its equations of motion, for the time integration and the shooting.
 LumpedSystem system_of(const Lumped& l) {
-  const auto& lin = static_cast<const frf::LumpedLinearPart&>(*l.model.linear);
-  return {lin.mass(), lin.damping(), lin.stiffness(), lin.contact_operator(), lin.force_vector()};
+  return lumped_system(static_cast<const frf::LumpedLinearPart&>(*l.model.linear));
 }
 
 /// The 2-DOF chain M = s^2 I, K = [[2, -1], [-1, 2]], C = 0.02 s K with a Jenkins element on
