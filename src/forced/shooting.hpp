@@ -70,12 +70,6 @@ struct ShootingOptions {
   bool validate(std::vector<std::string>* errors) const;
 };
 
-/// The work bound of one curve's shooting, in state-steps (one state marched one step): a
-/// curve whose points would need more is judged at every k-th point (the smallest k within
-/// it). About 45 s on this project's 2-core machines for 6 DOFs with 3 contacts (~300 ns a
-/// state-step), a few seconds for the 1 to 3 DOF models.
-constexpr double kShootingBudget = 3e8;
-
 struct ShootingResult {
   bool available = false;
   std::string reason;  ///< why not available

@@ -188,6 +188,15 @@ std::string to_string(ModalShroud shroud) {
   return "?";
 }
 
+std::string to_string(StabilityMethod method) {
+  switch (method) {
+    case StabilityMethod::automatic: return "auto";
+    case StabilityMethod::hill: return "hill";
+    case StabilityMethod::shooting: return "shooting";
+  }
+  return "?";
+}
+
 std::string default_case_text() {
   std::ostringstream s;
   s << "# shroudsim case file: every key at its default.\n"

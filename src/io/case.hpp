@@ -25,8 +25,12 @@ namespace shroudsim::io {
 enum class StructureType { sector, lumped };
 /// modal.shroud: the shroud contact of `modes` and `campbell` (docs/physics.md sections 1, 8).
 enum class ModalShroud { open, stuck, contact };
-std::string to_string(StructureType type);  ///< "sector", "lumped"
-std::string to_string(ModalShroud shroud);  ///< "open", "stuck", "contact"
+/// response.stability_method: how frf judges the stability of its points (docs/physics.md
+/// section 9): automatic = shooting for a lumped model with friction, Hill's method otherwise.
+enum class StabilityMethod { automatic, hill, shooting };
+std::string to_string(StructureType type);      ///< "sector", "lumped"
+std::string to_string(ModalShroud shroud);      ///< "open", "stuck", "contact"
+std::string to_string(StabilityMethod method);  ///< "auto", "hill", "shooting"
 
 // The members below get their defaults from the schema (Case's constructor), not here.
 
@@ -94,7 +98,10 @@ struct ResponseSection {
   int dof;                           ///< lumped only
   bool shapes = true;                ///< sector: frf.vtu, frf.pvd and contact.vtu (the ODS and contact maps)
   std::vector<double> shapes_at_hz;  ///< further frequencies of shapes and contact maps [Hz]
-  bool stability = true;             ///< frf: Floquet exponents of every point (Hill's method)
+  bool stability = true;             ///< frf: Floquet exponents of every point
+  StabilityMethod stability_method;  ///< Hill's method or shooting (automatic: by the model)
+  int shooting_steps;                ///< shooting: least integration steps per excitation period
+  double shooting_work;              ///< shooting: work bound of one curve [state-steps]
 };
 
 /// A lumped contact element: one DOF per direction (-1: absent), to ground or to other DOFs.

@@ -561,8 +561,26 @@ Schema declare() {
             "frf: write the operating deflection shapes (sector: frf.vtu, frf.pvd) and contact maps (contact_map.csv, "
             "sector: contact.vtu) at every resonance peak and at response.shapes_at_hz");
   d.boolean("response.stability", at(&Case::response, &ResponseSection::stability), true,
-            "frf: the local stability of every point by Hill's method (frf.csv column `stable`, run.json "
+            "frf: the local stability of every point, by response.stability_method (frf.csv column `stable`, run.json "
             "frf.stability with the changes of stability: folds, period doublings, Neimark-Sacker points)");
+  d.choice("response.stability_method", at(&Case::response, &ResponseSection::stability_method),
+           StabilityMethod::automatic, {StabilityMethod::automatic, StabilityMethod::hill, StabilityMethod::shooting},
+           to_string,
+           "frf: how the points are judged (docs/physics.md section 9): hill = Hill's method on the harmonic "
+           "balance's linearization (any model; with friction it drops the slider's memory); shooting = Floquet "
+           "multipliers of the time integration's period map (lumped models); auto = shooting for a lumped model "
+           "with friction, hill otherwise")
+      .rule("shooting: a lumped structure (the FE sector has no time integration)",
+            [](const Case& c, const StabilityMethod& v) { return v != StabilityMethod::shooting || lumped(c); });
+  d.integer("response.shooting_steps", at(&Case::response, &ResponseSection::shooting_steps), 4096, "",
+            "shooting: least time steps per excitation period (more where the stuck contact's highest mode needs "
+            "them); the verdicts' error and cost against it: docs/physics.md section 9")
+      .range(256, 65536);
+  d.number("response.shooting_work", at(&Case::response, &ResponseSection::shooting_work), 1e8, "state-steps",
+           "shooting: work bound of one curve, counted as the most its points could take (a state-step: one state "
+           "of the time integration advanced one step): a curve that could need more is judged at every k-th point, "
+           "the smallest k within the bound (run.json frf.stability.work, stride)")
+      .within(1e5, End::closed, 1e12, End::closed);
   d.numbers("response.shapes_at_hz", at(&Case::response, &ResponseSection::shapes_at_hz), {}, "Hz",
             "frf: further frequencies of shapes and contact maps (one per crossing of the curve)")
       .rule("every frequency > 0 and finite", [](const Case&, const std::vector<double>& v) {

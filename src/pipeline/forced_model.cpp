@@ -82,6 +82,14 @@ std::vector<int> forced_harmonic_indices(const io::Case& c) {
   return {needed.begin(), needed.end()};
 }
 
+bool judged_by_shooting(const io::Case& c) {
+  if (c.structure.type != io::StructureType::lumped || !c.response.stability) return false;
+  if (c.response.stability_method != io::StabilityMethod::automatic)
+    return c.response.stability_method == io::StabilityMethod::shooting;
+  return std::any_of(c.contact.elements.begin(), c.contact.elements.end(),
+                     [&](const io::ContactElement& e) { return pair_of(c.contact, &e).friction_coefficient > 0.0; });
+}
+
 std::string sector_stability_refusal(const io::Case& c) {
   if (c.structure.type != io::StructureType::sector) return "";
   return "not analysed for an FE sector (docs/physics.md section 9): the analysis judges every harmonic index's "

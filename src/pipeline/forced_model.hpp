@@ -22,6 +22,11 @@ ForcedModel make_lumped_model(const io::Case& c);
 /// The harmonic indices a sector case's forced response needs: h_n = n m mod Nb, n = 1..H,
 /// sorted, unique (h = 0 of the static harmonic comes from K_0, not from modes).
 std::vector<int> forced_harmonic_indices(const io::Case& c);
+/// Whether a case's forced response is judged by shooting (docs/physics.md section 9): a lumped
+/// model with response.stability on and response.stability_method "shooting", or "auto" with
+/// friction at any contact element.
+bool judged_by_shooting(const io::Case& c);
+
 /// Why a case's forced response gets no stability analysis although response.stability is on
 /// (an FE sector, docs/physics.md section 9); empty when it gets one.
 std::string sector_stability_refusal(const io::Case& c);

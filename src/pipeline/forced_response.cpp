@@ -112,22 +112,21 @@ std::vector<forced::FloquetResult> hill_stability(const forced::FrequencyRespons
 /// The Floquet multipliers of every point by shooting on the time integration
 /// (forced/shooting.hpp): the lumped models with friction, whose slider memory Hill's
 /// linearization drops. `s` gets the shooting's own figures.
-std::vector<forced::FloquetResult> shooting_stability(const forced::FrequencyResponse& response,
-                                                      forced::ReducedEquations& equations,
-                                                      const frf::LumpedLinearPart& lumped,
-                                                      const std::vector<contact::PairParameters>& pairs,
-                                                      contact::Model law, int threads, std::vector<std::string>& errors,
-                                                      nlohmann::json& s) {
+std::vector<forced::FloquetResult> shooting_stability(
+    const forced::FrequencyResponse& response, forced::ReducedEquations& equations, const frf::LumpedLinearPart& lumped,
+    const std::vector<contact::PairParameters>& pairs, contact::Model law, const io::ResponseSection& settings,
+    int threads, std::vector<std::string>& errors, nlohmann::json& s) {
   const std::size_t n = response.points.size();
   const forced::LumpedSystem system = forced::lumped_system(lumped);
-  // The work bound (forced::kShootingBudget): every stride-th point of a curve that would
+  // The work bound (response.shooting_work): every stride-th point of a curve that would
   // exceed it is judged, the others left undecided (the same points at any thread count).
-  const forced::ShootingOptions options;
+  forced::ShootingOptions options;
+  options.min_steps_per_period = settings.shooting_steps;
   double work = 0.0;
   for (std::size_t i = 0; i < n; ++i)
     work += forced::shooting_work(system, pairs, law, response.points[i].lambda, options);
   const std::size_t stride =
-      std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(work / forced::kShootingBudget)));
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(work / settings.shooting_work)));
   const auto judged = [&](std::size_t k) { return k % stride == 0 || k + 1 == n; };
   std::vector<Eigen::VectorXd> u0(n), v0(n), d0(n);
   // The states from the harmonics in order (the equations are not shared between threads).
@@ -148,6 +147,8 @@ std::vector<forced::FloquetResult> shooting_stability(const forced::FrequencyRes
     shots[k] = forced::shooting_floquet(system, pairs, law, response.points[k].lambda, u0[k], v0[k], d0[k], options);
   });
   s["stride"] = stride;
+  s["work"] = work;
+  s["work_bound"] = settings.shooting_work;
   std::vector<forced::FloquetResult> out(n);
   double start_mismatch = 0.0, mismatch = 0.0;
   int iterations = 0, steps = 0, state = 0, settled = 0, left = 0;
@@ -231,13 +232,14 @@ void report_stability(nlohmann::json& s, const std::vector<forced::FloquetResult
             (failed ? ", " + std::to_string(failed) + " points not analysed" : ""));
 }
 
-/// The stability of every point and run.json's frf.stability. A lumped model with friction is
-/// judged by shooting (its slider memory is part of the time integration's state), with Hill's
-/// verdicts counted against it (docs/physics.md section 9); every other model by Hill.
+/// The stability of every point and run.json's frf.stability, by response.stability_method:
+/// "auto" judges a lumped model with friction by shooting (its slider memory is part of the
+/// time integration's state) and every other model by Hill; with shooting, Hill's verdicts are
+/// counted against it (docs/physics.md section 9).
 std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
                                                      forced::ReducedEquations& equations,
                                                      const hbm::ContactEvaluator& evaluator, contact::Model law,
-                                                     int threads) {
+                                                     const io::ResponseSection& settings, int threads) {
   const log::Stopwatch clock;
   auto& s = j["stability"];
   s = nlohmann::json::object();
@@ -247,14 +249,23 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   const auto& pairs = evaluator.pairs();
   const bool friction =
       std::any_of(pairs.begin(), pairs.end(), [](const auto& p) { return p.friction_coefficient > 0; });
-  if (lumped == nullptr || !friction) {
+  const bool shooting = lumped != nullptr &&
+                        (settings.stability_method == io::StabilityMethod::shooting ||
+                         (settings.stability_method == io::StabilityMethod::automatic && friction));
+  s["requested"] = io::to_string(settings.stability_method);
+  if (!shooting) {
+    if (lumped != nullptr && friction)
+      log::warn(
+          "frf: stability by Hill's method as response.stability_method asks: its linearization drops the "
+          "friction slider's memory, and on lumped friction models it calls stable points unstable "
+          "(docs/physics.md section 9)");
     report_stability(s, hill, errors, response, "hill");
     s["seconds"] = clock.seconds();
     return hill;
   }
   std::vector<std::string> shooting_errors;
   std::vector<forced::FloquetResult> out =
-      shooting_stability(response, equations, *lumped, pairs, law, threads, shooting_errors, s);
+      shooting_stability(response, equations, *lumped, pairs, law, settings, threads, shooting_errors, s);
   report_stability(s, out, shooting_errors, response, "shooting");
   // Hill's verdicts against the shooting's, where both judged.
   int hill_unstable = 0, disagree = 0, judged = 0;
@@ -432,7 +443,7 @@ ForcedResponseOutcome trace_case(Context& ctx) {
     // (shooting) would cost more than the curve.
     j["stability"] = {{"available", false}, {"reason", "the curve did not pass its checks; its points are not judged"}};
   } else if (c.response.stability) {
-    stability = analyse_stability(j, response, equations, evaluator, eo.law.model, ctx.threads);
+    stability = analyse_stability(j, response, equations, evaluator, eo.law.model, c.response, ctx.threads);
   }
   const bool analysed = c.response.stability && j["stability"]["available"].get<bool>();
   write_frf_csv(ctx.out_dir / "frf.csv", response, c.hbm.harmonics, analysed ? &stability : nullptr);
@@ -496,17 +507,23 @@ Context trial_context(const Context& ctx, int h, int n, const std::filesystem::p
 /// hbm.harmonics and/or hbm.time_samples = "auto": the search of
 /// forced/discretization_search.hpp, each trial a full forced response into
 /// <out>/auto/H=..__N=../ compared in memory; the accepted trial's frf.csv, loops.csv and
-/// peaks.csv are the result, and run.json lists every trial under "auto".
+/// peaks.csv are the result, and run.json lists every trial under "auto". Where the points are
+/// judged by shooting, which costs more than a curve, the trials are traced without it and the
+/// accepted one is traced again and judged (the same curve: a trial is deterministic).
 ForcedResponseOutcome search_discretization(Context& ctx) {
   const io::Case& c = ctx.config;
   log::Stopwatch clock;
   const bool verbose = log::verbose();
+  const bool judge_accepted_only = judged_by_shooting(c);
   std::vector<nlohmann::json> frf_sections;  // each trial's run.json "frf", in order
   std::vector<std::filesystem::path> dirs;
+  const auto trial_dir = [&](int h, int n) {
+    return ctx.out_dir / "auto" / ("H=" + std::to_string(h) + "__N=" + std::to_string(n));
+  };
   auto run_trial = [&](int h, int n) {
     forced::DiscretizationTrial t;
-    Context tc =
-        trial_context(ctx, h, n, ctx.out_dir / "auto" / ("H=" + std::to_string(h) + "__N=" + std::to_string(n)), false);
+    Context tc = trial_context(ctx, h, n, trial_dir(h, n), false);
+    if (judge_accepted_only) tc.config.response.stability = false;
     log::set_verbose(false);
     try {
       t.message = trace_case(tc).failure;
@@ -551,6 +568,22 @@ ForcedResponseOutcome search_discretization(Context& ctx) {
   }
   const forced::DiscretizationTrial& chosen = search.trials[search.chosen];
   const std::filesystem::path& chosen_dir = dirs[search.chosen];
+  if (judge_accepted_only && chosen.ok) {
+    log::info("frf: auto: the accepted curve (H = " + std::to_string(chosen.harmonics) +
+              ", N = " + std::to_string(chosen.time_samples) + ") traced again and judged by shooting");
+    Context tc = trial_context(ctx, chosen.harmonics, chosen.time_samples, chosen_dir, false);
+    log::set_verbose(false);
+    try {
+      const std::string failure = trace_case(tc).failure;
+      log::set_verbose(verbose);
+      if (!failure.empty())  // a trial is a pure function of its H and N: its curve again
+        throw NumericalError("frf: auto: the accepted curve traced again failed: " + failure);
+    } catch (...) {
+      log::set_verbose(verbose);
+      throw;
+    }
+    frf_sections[search.chosen] = tc.report.json().value("frf", nlohmann::json::object());
+  }
   for (const char* f : {"frf.csv", "loops.csv", "peaks.csv"})
     if (std::filesystem::exists(chosen_dir / f))
       io::write_file_atomic(ctx.out_dir / f, study::read_file(chosen_dir / f));

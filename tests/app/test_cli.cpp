@@ -253,6 +253,23 @@ TEST(Cli, AutoHarmonicsAndSamplesStopWhereThePeaksSettle) {
   ASSERT_GT(lines.size(), 20u);
   EXPECT_NE(lines[0].find(",h" + std::to_string(h) + "_m,piece"), std::string::npos) << lines[0];
   EXPECT_EQ(lines[0].find(",h" + std::to_string(h + 1) + "_m"), std::string::npos) << lines[0];
+  // A Jenkins element is judged by shooting, which costs more than a curve: only the accepted
+  // trial is judged (its frf.csv has the `stable` column, the other trials' do not).
+  EXPECT_EQ(run.at("frf").at("stability").at("method").get<std::string>(), "shooting");
+  EXPECT_EQ(run.at("frf").at("stability").at("failed_points").get<int>(), 0);
+  EXPECT_NE(lines[0].find(",piece,stable"), std::string::npos) << lines[0];
+  for (const auto& t : a.at("trials")) {
+    const fs::path dir = s.dir() / "results" / "jenkins" / "auto" /
+                         ("H=" + std::to_string(t.at("harmonics").get<int>()) +
+                          "__N=" + std::to_string(t.at("time_samples").get<int>()));
+    const auto trial = lines_of(slurp(dir / "frf.csv"));
+    ASSERT_FALSE(trial.empty()) << dir;
+    const bool is_accepted = t.at("harmonics") == h && t.at("time_samples") == n;
+    EXPECT_EQ(trial[0].find(",stable") != std::string::npos, is_accepted) << dir;
+    if (is_accepted) {
+      EXPECT_EQ(trial, lines) << "the accepted trial traced again is the same curve";
+    }
+  }
 }
 
 TEST(Cli, ConvergenceStudyTabulatesEveryKnobAgainstItsFinestValue) {

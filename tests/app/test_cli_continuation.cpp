@@ -151,6 +151,9 @@ force = 16999.121192627077
 dof = 3
 
 [response]
+# The continuation is this test's subject; the stability stage, which would
+# cost more than the curve here, is tested on its own (stability tests below).
+stability = false
 dof = 0
 
 [contact]
@@ -227,6 +230,9 @@ force = 3.498485488581492
 dof = 2
 
 [response]
+# The continuation is this test's subject; the stability stage, which would
+# cost more than the curve here, is tested on its own (stability tests below).
+stability = false
 dof = 0
 
 [contact]
@@ -466,6 +472,9 @@ force = 401.5283804791073
 dof = 2
 
 [response]
+# The continuation is this test's subject; the stability stage, which would
+# cost more than the curve here, is tested on its own (stability tests below).
+stability = false
 dof = 1
 
 [contact]
@@ -539,6 +548,9 @@ force = 77.86869524095493
 dof = 3
 
 [response]
+# The continuation is this test's subject; the stability stage, which would
+# cost more than the curve here, is tested on its own (stability tests below).
+stability = false
 dof = 0
 
 [contact]
@@ -666,6 +678,59 @@ TEST(CliContinuation, TheMiddleBranchBetweenTwoFoldsIsReportedUnstable) {
   EXPECT_GE(backwards_unstable, unstable - 4);
 }
 
+TEST(CliContinuation, ShootingAndHillAgreeOnAFrictionlessGapOscillator) {
+  // Without friction the contact law has no memory, and Hill's method on the harmonic balance's
+  // linearization (the default here) and the shooting on the time integration
+  // (response.stability_method = "shooting") are two independent judgements of the same
+  // solutions: the same two folds, and the same verdict at every point but those next to a fold
+  // (within kNearFold points of where Hill's verdict changes), where a multiplier is within the
+  // integration's error of 1 and Newton on the period map converges slowly. The folds' frequencies
+  // agree to kFoldAgreement, relative: both are interpolated between the two points either side,
+  // which lie closer than that together near a fold (measured: 8e-6 and 5e-6).
+  constexpr int kNearFold = 2;
+  constexpr double kFoldAgreement = 1e-4;
+  const Scratch s("stability_both");
+  s.write("case.toml", slurp(std::filesystem::path(SHROUDSIM_SOURCE_DIR) / "cases" / "gap_oscillator.toml"));
+  ASSERT_EQ(s.run("frf case.toml --quiet --threads 2 --out hill").status, 0);
+  const CliResult r =
+      s.run("frf case.toml --quiet --threads 2 --out shooting --set response.stability_method=\"shooting\"");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto hill = frf_of(s, "hill")["stability"];
+  const auto st = frf_of(s, "shooting")["stability"];
+  EXPECT_EQ(hill["method"].get<std::string>(), "hill");
+  EXPECT_EQ(st["requested"].get<std::string>(), "shooting");
+  EXPECT_EQ(st["method"].get<std::string>(), "shooting");
+  EXPECT_EQ(st["stride"].get<int>(), 1);
+  ASSERT_EQ(st["changes"].size(), 2u);
+  ASSERT_EQ(hill["changes"].size(), 2u);
+  for (std::size_t c = 0; c < 2; ++c) {
+    EXPECT_EQ(st["changes"][c]["kind"].get<std::string>(), "fold");
+    const double f = hill["changes"][c]["frequency_hz"].get<double>();
+    EXPECT_NEAR(st["changes"][c]["frequency_hz"].get<double>(), f, kFoldAgreement * f);
+  }
+  const auto a = csv_rows(slurp(s.dir() / "hill" / "frf.csv"));
+  const auto b = csv_rows(slurp(s.dir() / "shooting" / "frf.csv"));
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 10u);
+  std::vector<std::size_t> folds;  // rows where Hill's verdict changes
+  for (std::size_t i = 2; i < a.size(); ++i)
+    if (a[i].back() != a[i - 1].back()) folds.push_back(i);
+  ASSERT_EQ(folds.size(), 2u);
+  int differ = 0;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    EXPECT_EQ(a[i][0], b[i][0]) << "row " << i;  // the same curve
+    if (a[i].back() == b[i].back()) continue;
+    ++differ;
+    const bool near = std::any_of(folds.begin(), folds.end(), [&](std::size_t f) {
+      return std::abs(static_cast<long>(i) - static_cast<long>(f)) <= kNearFold;
+    });
+    EXPECT_TRUE(near) << "row " << i << " at " << a[i][0] << " Hz: Hill " << a[i].back() << ", shooting "
+                      << b[i].back();
+  }
+  EXPECT_LE(differ, 2 * (2 * kNearFold + 1));
+  EXPECT_GT(st["unstable_points"].get<int>(), 10);
+}
+
 /// Stress corpus model 8 (3 DOFs, quasi3d friction, H = 15, N = 128) with time rescaled by s:
 /// mass s^2, damping s, frequencies / s.
 std::string model_8(double s) {
@@ -734,6 +799,26 @@ TEST(CliContinuation, ALumpedFrictionModelIsJudgedByShootingTheSameAtAnyTimeScal
     }
   }
   EXPECT_EQ(tables[0].size(), tables[1].size());
+}
+
+TEST(CliContinuation, HillsMethodIsUsedOnAFrictionModelWhenTheCaseAsksAndWarned) {
+  // response.stability_method = "hill" on a lumped friction model: Hill's verdicts (which drop
+  // the slider's memory) in the `stable` column, with a warning; "auto" judges it by shooting.
+  const Scratch s("stability_hill");
+  s.write("case.toml", model_8(1.0));
+  const CliResult r = s.run("frf case.toml --threads 2 --out hill --set response.stability_method=\"hill\"");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("drops the friction slider's memory"), std::string::npos) << r.err;
+  const auto frf = frf_of(s, "hill");
+  const auto& st = frf["stability"];
+  EXPECT_EQ(st["requested"].get<std::string>(), "hill");
+  EXPECT_EQ(st["method"].get<std::string>(), "hill");
+  EXPECT_FALSE(st.contains("hill"));
+  EXPECT_GT(st["unstable_points"].get<int>(), 0);  // the points the shooting calls stable
+  const auto rows = csv_rows(slurp(s.dir() / "hill" / "frf.csv"));
+  int zeros = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) zeros += rows[i].back() == "0" ? 1 : 0;
+  EXPECT_EQ(zeros, st["unstable_points"].get<int>());
 }
 
 }  // namespace

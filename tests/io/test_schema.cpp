@@ -11,6 +11,7 @@
 #include "continuation/arclength.hpp"
 #include "core/error.hpp"
 #include "forced/frequency_response.hpp"
+#include "forced/shooting.hpp"
 #include "frf/sector.hpp"
 #include "frf/static_shroud.hpp"
 #include "io/case.hpp"
@@ -56,14 +57,15 @@ TEST(Schema, EveryWordOfAChoiceReadsBackAsItself) {
     for (auto it = std::sregex_iterator(spec.range.begin(), spec.range.end(), word); it != std::sregex_iterator();
          ++it) {
       const std::string w = (*it)[1];
-      const Case c = parse_case(spec.key == "structure.type" && w == "lumped" ? lumped : "", "case.toml",
-                                {spec.key + "=\"" + w + "\""});
+      const bool needs_lumped = (spec.key == "structure.type" && w == "lumped") ||
+                                (spec.key == "response.stability_method" && w == "shooting");
+      const Case c = parse_case(needs_lumped ? lumped : "", "case.toml", {spec.key + "=\"" + w + "\""});
       EXPECT_EQ(spec.value_toml(c), "\"" + w + "\"") << spec.key;
     }
   }
   // structure.type, modal.eigensolver, modal.shroud, contact.model, contact.discretization,
-  // contact.tangential_update, hbm.jacobian, study.method
-  EXPECT_EQ(choices, 8);
+  // contact.tangential_update, hbm.jacobian, study.method, response.stability_method
+  EXPECT_EQ(choices, 9);
 }
 
 TEST(Schema, MessagesQuoteTheDocumentedRule) {
@@ -181,6 +183,9 @@ TEST(Schema, LibraryDefaultsAgreeWithTheCaseDefaults) {
   const modal::ModalOptions modal;
   EXPECT_EQ(modal.modes, c.modal.modes);
   EXPECT_EQ(modal.method, c.modal.eigensolver);
+
+  const forced::ShootingOptions shooting;
+  EXPECT_EQ(shooting.min_steps_per_period, c.response.shooting_steps);
 
   const frf::SectorForcing forcing;  // (excitation node and force: no default, set by the caller)
   EXPECT_EQ(forcing.engine_order, c.excitation.engine_order);
