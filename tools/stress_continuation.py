@@ -12,6 +12,9 @@ table, one line per failure and a summary.
   python3 tools/stress_continuation.py --count 50 --seed 7 --csv /tmp/stress.csv
   python3 tools/stress_continuation.py --set response.stability=false   # the continuation alone
 
+The stress models the tests and docs/ name by number ("stress corpus model 8") are of seed 1
+drawn with --raw-preload (the corpus before 2026-12-05; their case files are in the tests).
+
 The corpus depends only on --seed (model i is drawn from its own generator seeded with
 "seed:i", so the first k models are the same whatever --count is). Pure Python (no numpy):
 the models are at most 6 x 6, and the script runs under any python3.
@@ -31,14 +34,19 @@ How a model is drawn (every parameter is recorded in the CSV and the failure lin
   (z > 0 presses), frame angle 0 or uniform in 0..90 degrees;
 - preload regime: "pressed" (N0 > 0), "zero" (N0 = 0) or, for quasi3d/full3d only, "gap"
   (N0 < 0: an initial gap g = -N0/kn; the 1d law has a constant normal load and refuses a
-  negative preload);
+  negative preload). Pressed: the load the contact carries at rest, N_s, is drawn log-uniform
+  in 1e-3..1e3; the case's normal_preload N0 acts at zero relative displacement and the
+  structure gives way under it, so N0 = N_s / (N_s / N0 of the stuck structure at rest)
+  (--raw-preload: N0 = the drawn load, the corpus before 2026-12-05, whose contacts carried
+  1e-4..1 of it at rest); the static tangential load at rest against mu N_s is recorded
+  (static_tangential: above 1 the contact slips at rest already);
 - excitation force: sized so that the linear response is r times the reference length,
   r log-uniform in 0.3..30: pressed: the peak tangential contact motion of the STUCK
   linear system (contact springs kt, and kn in the normal) over the range against the slip
-  displacement mu N0 / kt (r < 1: stays stuck; r > 1: slips); gap: the peak normal contact
+  displacement mu N_s / kt (r < 1: stays stuck; r > 1: slips); gap: the peak normal contact
   motion of the FREE system against the gap (r > 1: the contact closes); zero: the problem
   is homogeneous in the force, which is sized for a free contact motion of 1e-6..1e-2 m.
-  For pressed contacts the separation ratio s = kn max|w_z| / N0 of the stuck system is
+  For pressed contacts the separation ratio s = kn max|w_z| / N_s of the stuck system is
   recorded too (s > 1: the contact opens over part of the period);
 - frequency range around a resonance: centre = the free first mode (55 %), a random free
   mode (20 %) or the first mode of the stuck system (25 %, pressed contacts only; else a
@@ -208,6 +216,25 @@ def contact_motion_peak(k, mdiag, c, dirs, exc, freqs):
     return tmax, zmax
 
 
+def stuck_static_state(ks, dirs, kn, kt, mu):
+    """The stuck contact at rest under a unit preload (quasi3d, full3d): the structure with the
+    contact springs, ks u = -b_z (the preload pushes the contact's normal DOF back, b_z its
+    relative normal motion's row), gives the load the contact carries, N_s = 1 + kn w_z, and
+    its tangential load kt |(w_x, w_y)| with the sliders at rest. Returns (N_s, tangential
+    load / (mu N_s)): above 1 the contact already slips at rest."""
+    n = len(ks)
+    b = [[0.0] * n for _ in range(3)]
+    for d, (dof, oth) in enumerate(dirs):
+        if dof >= 0:
+            b[d][dof] += 1.0
+            if oth >= 0:
+                b[d][oth] -= 1.0
+    u = [x.real for x in solve_complex([[complex(v) for v in row] for row in ks], [complex(-v) for v in b[2]])]
+    w = [sum(b[d][i] * u[i] for i in range(n)) for d in range(3)]
+    load = 1.0 + kn * w[2]
+    return load, kt * math.hypot(w[0], w[1]) / (mu * load)
+
+
 def add_spring(k, kval, d, o):
     """Adds a spring of stiffness kval between DOF d and DOF o (-1: ground)."""
     k[d][d] += kval
@@ -223,7 +250,7 @@ def sample_freqs(lo, hi, extra):
     return fs
 
 
-def draw_model(seed, index):
+def draw_model(seed, index, raw_preload=False):
     rng = random.Random("shroudsim-stress:%d:%d" % (seed, index))
     p = {"name": "stress_%04d" % index, "index": index}
     model = rng.choice(["1d", "quasi3d", "full3d"])
@@ -325,13 +352,24 @@ def draw_model(seed, index):
     freqs_stuck = sample_freqs(lo, hi, stuck_modes)
     freqs_free = sample_freqs(lo, hi, free_modes)
     separation = float("nan")
+    static_load_ratio = static_tangential = float("nan")
     if regime == "pressed":
-        n0 = log_uniform(rng, 1e-3, 1e3)
-        slip = mu * n0 / kt
+        # n_c: the normal load the contact carries at rest. The case's preload N0 acts at zero
+        # relative displacement and the structure gives way under it (docs/physics.md section 3):
+        # at rest the stuck contact carries N0 * static_load_ratio (quasi3d, full3d; the 1d law's
+        # normal load is N0 itself), so N0 is drawn for that load, and the slip displacement and
+        # the separation ratio are those of the load it carries.
+        n_c = log_uniform(rng, 1e-3, 1e3)
+        n0 = n_c
+        if three_d:
+            static_load_ratio, static_tangential = stuck_static_state(ks, dirs, kn, kt, mu)
+            if not raw_preload:
+                n0 = n_c / static_load_ratio
+        slip = mu * n_c / kt
         tpk, zpk = contact_motion_peak(ks, mdiag, c, dirs, exc, freqs_stuck)
         force = r * slip / tpk
         if three_d:
-            separation = kn * zpk * force / n0
+            separation = kn * zpk * force / n_c
         reference = "slip %.3g m" % slip
     elif regime == "gap":
         gap = log_uniform(rng, 1e-6, 1e-2)
@@ -348,7 +386,8 @@ def draw_model(seed, index):
         reference = "free motion %.3g m" % amp
     if not (math.isfinite(force) and force > 0.0):
         raise RuntimeError("%s: force %r (linear response %r, %r)" % (p["name"], force, tpk, zpk))
-    p.update(N0=n0, r=r, separation=separation, force=force, reference=reference)
+    p.update(N0=n0, r=r, separation=separation, force=force, reference=reference,
+             static_load_ratio=static_load_ratio, static_tangential=static_tangential)
     if regime == "pressed":
         p["expect"] = ("slip" if r > 1.0 else "stick") + ("+separation" if separation > 1.0 else "")
     elif regime == "gap":
@@ -425,10 +464,13 @@ def case_toml(p, mdiag, k, c, node, other, frame, three_d):
 def describe(p):
     return ("%s n=%d %s f1=%.4g Hz range %.4g..%.4g Hz (%s) zeta=%.3g (%s) kt/k=%.3g kn/k=%.3g mu=%.3g "
             "N0=%.4g (%s, %s) r=%.3g sep=%.3g -> %s H=%d N=%d exc=%d resp=%d contact=[%s] other=[%s] frame=%.3g"
+            "%s"
             % (p["model"], p["n"], p["structure"], p["f1_hz"], p["f_start_hz"], p["f_end_hz"], p["around"],
                p["zeta"], p["damping"], p["kt_ratio"], p["kn_ratio"], p["mu"], p["N0"], p["regime"],
                p["reference"], p["r"], p["separation"], p["expect"], p["H"], p["N"], p["excitation_dof"],
-               p["response_dof"], p["contact_dofs"], p["other_dofs"], p["frame_deg"]))
+               p["response_dof"], p["contact_dofs"], p["other_dofs"], p["frame_deg"],
+               "" if not math.isfinite(p["static_load_ratio"]) else
+               " at rest: N = %.3g N0, tangential %.3g mu N" % (p["static_load_ratio"], p["static_tangential"])))
 
 
 # ---------------------------------------------------------------------------------------
@@ -515,6 +557,9 @@ def main():
                          "so that a rebuild during the benchmark does not mix two programs)")
     ap.add_argument("--keep-results", action="store_true",
                     help="keep the result folders of runs that exit 0 too")
+    ap.add_argument("--raw-preload", action="store_true",
+                    help="the corpus before 2026-12-05: normal_preload = the drawn load, which the structure "
+                         "relaxes at rest (to 1e-4..1 of it), so that 'pressed' draws mostly slip and lift off")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="a case key for every run (repeatable), e.g. response.stability=false to time the "
                          "continuation alone; continuation keys are refused (the corpus runs their defaults)")
@@ -547,7 +592,7 @@ def main():
         sys.exit("stress_continuation: %s does not run (%s); is it being rebuilt?" % (binary, e))
 
     t_start = time.monotonic()
-    models = [draw_model(args.seed, i) for i in range(args.count)]
+    models = [draw_model(args.seed, i, args.raw_preload) for i in range(args.count)]
     for p in models:
         with open(os.path.join(out, "cases", p["name"] + ".toml"), "w") as f:
             f.write(p["toml"])
