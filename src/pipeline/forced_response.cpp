@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "continuation/arclength.hpp"
@@ -239,7 +240,7 @@ void report_stability(nlohmann::json& s, const std::vector<forced::FloquetResult
 std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
                                                      forced::ReducedEquations& equations,
                                                      const hbm::ContactEvaluator& evaluator, contact::Model law,
-                                                     const io::ResponseSection& settings, int threads) {
+                                                     const io::Case& c, int threads) {
   const log::Stopwatch clock;
   auto& s = j["stability"];
   s = nlohmann::json::object();
@@ -249,10 +250,9 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   const auto& pairs = evaluator.pairs();
   const bool friction =
       std::any_of(pairs.begin(), pairs.end(), [](const auto& p) { return p.friction_coefficient > 0; });
-  const bool shooting = lumped != nullptr &&
-                        (settings.stability_method == io::StabilityMethod::shooting ||
-                         (settings.stability_method == io::StabilityMethod::automatic && friction));
-  s["requested"] = io::to_string(settings.stability_method);
+  const bool shooting = judged_by_shooting(c);
+  if (shooting && lumped == nullptr) throw std::logic_error("analyse_stability: shooting needs a lumped model");
+  s["requested"] = io::to_string(c.response.stability_method);
   if (!shooting) {
     if (lumped != nullptr && friction)
       log::warn(
@@ -265,7 +265,7 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   }
   std::vector<std::string> shooting_errors;
   std::vector<forced::FloquetResult> out =
-      shooting_stability(response, equations, *lumped, pairs, law, settings, threads, shooting_errors, s);
+      shooting_stability(response, equations, *lumped, pairs, law, c.response, threads, shooting_errors, s);
   report_stability(s, out, shooting_errors, response, "shooting");
   // Hill's verdicts against the shooting's, where both judged.
   int hill_unstable = 0, disagree = 0, judged = 0;
@@ -443,7 +443,7 @@ ForcedResponseOutcome trace_case(Context& ctx) {
     // (shooting) would cost more than the curve.
     j["stability"] = {{"available", false}, {"reason", "the curve did not pass its checks; its points are not judged"}};
   } else if (c.response.stability) {
-    stability = analyse_stability(j, response, equations, evaluator, eo.law.model, c.response, ctx.threads);
+    stability = analyse_stability(j, response, equations, evaluator, eo.law.model, c, ctx.threads);
   }
   const bool analysed = c.response.stability && j["stability"]["available"].get<bool>();
   write_frf_csv(ctx.out_dir / "frf.csv", response, c.hbm.harmonics, analysed ? &stability : nullptr);
@@ -516,14 +516,15 @@ ForcedResponseOutcome search_discretization(Context& ctx) {
   const bool verbose = log::verbose();
   const bool judge_accepted_only = judged_by_shooting(c);
   std::vector<nlohmann::json> frf_sections;  // each trial's run.json "frf", in order
-  std::vector<std::filesystem::path> dirs;
   const auto trial_dir = [&](int h, int n) {
     return ctx.out_dir / "auto" / ("H=" + std::to_string(h) + "__N=" + std::to_string(n));
   };
-  auto run_trial = [&](int h, int n) {
+  // One trial curve into its folder, quietly; `judge`: with the case's stability analysis.
+  // `frf` gets the trial's run.json "frf".
+  const auto trace_trial = [&](int h, int n, bool judge, nlohmann::json& frf) {
     forced::DiscretizationTrial t;
     Context tc = trial_context(ctx, h, n, trial_dir(h, n), false);
-    if (judge_accepted_only) tc.config.response.stability = false;
+    if (!judge) tc.config.response.stability = false;
     log::set_verbose(false);
     try {
       t.message = trace_case(tc).failure;
@@ -535,13 +536,15 @@ ForcedResponseOutcome search_discretization(Context& ctx) {
       throw;
     }
     log::set_verbose(verbose);
-    const nlohmann::json frf = tc.report.json().value("frf", nlohmann::json::object());
+    frf = tc.report.json().value("frf", nlohmann::json::object());
     t.peak_amplitude_m = frf.value("peak_amplitude_m", 0.0);
     t.peak_frequency_hz = frf.value("peak_frequency_hz", 0.0);
     t.curve = std::move(tc.frf_curve);
-    frf_sections.push_back(frf);
-    dirs.push_back(tc.out_dir);
     return t;
+  };
+  auto run_trial = [&](int h, int n) {
+    frf_sections.emplace_back();
+    return trace_trial(h, n, !judge_accepted_only, frf_sections.back());
   };
   auto report_trial = [&](const forced::DiscretizationTrial& t) {
     std::ostringstream s;
@@ -567,22 +570,15 @@ ForcedResponseOutcome search_discretization(Context& ctx) {
     throw InputError(c.locations.at("hbm.harmonics") + ": hbm \"auto\": " + e.what());
   }
   const forced::DiscretizationTrial& chosen = search.trials[search.chosen];
-  const std::filesystem::path& chosen_dir = dirs[search.chosen];
+  const std::filesystem::path chosen_dir = trial_dir(chosen.harmonics, chosen.time_samples);
   if (judge_accepted_only && chosen.ok) {
     log::info("frf: auto: the accepted curve (H = " + std::to_string(chosen.harmonics) +
               ", N = " + std::to_string(chosen.time_samples) + ") traced again and judged by shooting");
-    Context tc = trial_context(ctx, chosen.harmonics, chosen.time_samples, chosen_dir, false);
-    log::set_verbose(false);
-    try {
-      const std::string failure = trace_case(tc).failure;
-      log::set_verbose(verbose);
-      if (!failure.empty())  // a trial is a pure function of its H and N: its curve again
-        throw NumericalError("frf: auto: the accepted curve traced again failed: " + failure);
-    } catch (...) {
-      log::set_verbose(verbose);
-      throw;
-    }
-    frf_sections[search.chosen] = tc.report.json().value("frf", nlohmann::json::object());
+    nlohmann::json frf;
+    const forced::DiscretizationTrial again = trace_trial(chosen.harmonics, chosen.time_samples, true, frf);
+    if (!again.ok)  // a trial is a pure function of its H and N: its curve again
+      throw NumericalError("frf: auto: the accepted curve traced again failed: " + again.message);
+    frf_sections[search.chosen] = std::move(frf);
   }
   for (const char* f : {"frf.csv", "loops.csv", "peaks.csv"})
     if (std::filesystem::exists(chosen_dir / f))
