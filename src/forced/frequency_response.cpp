@@ -11,6 +11,7 @@
 #include "continuation/events.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/log.hpp"
 #include "forced/excitation_homotopy.hpp"
 #include "forced/time_march.hpp"
 #include "frf/lumped.hpp"
@@ -175,6 +176,8 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
                               ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
                               std::string& how, const Info& info) {
   const double x_scale = ao.x_scale[0];
+  const log::Stopwatch clock;
+  auto after = [&] { return " (after " + fixed(clock.seconds(), 1) + " s)"; };
   how = "stuck contact";
   Eigen::VectorXd start = equations.stuck_solution(f);
   {
@@ -192,7 +195,8 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   if (eo.n_harmonics > 1) {
     // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
     // each new harmonic starting at zero (higher harmonics are small corrections).
-    say(info, "frf: no start at " + shortest(f) + " Hz from the stuck or the free state; trying harmonic stepping");
+    say(info, "frf: no start at " + shortest(f) + " Hz from the stuck or the free state" + after() +
+                  "; trying harmonic stepping");
     Eigen::VectorXd prev;
     int prev_h = 0;
     for (int h = 1; h <= eo.n_harmonics; ++h) {
@@ -228,12 +232,13 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
     if (prev_h == eo.n_harmonics) {
       how = "harmonic stepping";
       say(info, "frf: start point at " + shortest(f) + " Hz by harmonic stepping (H = 1 .. " +
-                    std::to_string(eo.n_harmonics) + ")");
+                    std::to_string(eo.n_harmonics) + ")" + after());
       return prev;
     }
   }
   how = "excitation homotopy";
-  say(info, "frf: no start at " + shortest(f) + " Hz by Newton; trying the continuation in the excitation level");
+  say(info, "frf: no start at " + shortest(f) + " Hz by Newton" + after() +
+                "; trying the continuation in the excitation level");
   const continuation::Branch h = solve_by_excitation_homotopy(equations, f, ao, start);
   if (h.status != continuation::BranchStatus::kReachedEnd)
     throw NumericalError(
@@ -241,7 +246,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
         " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
         h.message);
   say(info, "frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) +
-                " points)");
+                " points)" + after());
   return start;
 }
 
@@ -617,6 +622,36 @@ std::vector<std::size_t> prominent_maxima(const std::vector<double>& a, double m
   return out;
 }
 
+bool is_sampled_top(const ResponsePeak& peak, const std::array<const continuation::BranchPoint*, 3>& top,
+                    double sampled_amplitude, const Eigen::VectorXd& x_scale, double lambda_scale) {
+  // The amplitude of a traced point is known to about the corrector's tolerance (1e-8 of the
+  // x unit by default); a located maximum of the same top is at least as high to well within
+  // this.
+  constexpr double kAmplitudeSlack = 1e-6;
+  constexpr double kStepFraction = 0.25;
+  const bool unscaled = x_scale.size() == 0;
+  if (!peak.located || (!unscaled && peak.x.size() != x_scale.size())) return false;
+  if (peak.amplitude_m < (1.0 - kAmplitudeSlack) * sampled_amplitude) return false;
+  auto scaled = [&](const Eigen::VectorXd& x, double lambda) {
+    Eigen::VectorXd y(x.size() + 1);
+    if (unscaled) y.head(x.size()) = x;
+    else y.head(x.size()) = x.cwiseQuotient(x_scale);
+    y[x.size()] = lambda / lambda_scale;
+    return y;
+  };
+  const Eigen::VectorXd q = scaled(peak.x, peak.frequency_hz);
+  double longest = 0.0, nearest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::VectorXd a = scaled(top[k]->x, top[k]->lambda), b = scaled(top[k + 1]->x, top[k + 1]->lambda);
+    const Eigen::VectorXd ab = b - a;
+    const double length2 = ab.squaredNorm();
+    longest = std::max(longest, std::sqrt(length2));
+    const double t = length2 > 0.0 ? std::clamp((q - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    nearest = std::min(nearest, (q - a - t * ab).norm());
+  }
+  return nearest <= kStepFraction * longest;
+}
+
 namespace {
 
 // The results of every point (energy balance polished where it misses) and the located peaks.
@@ -658,6 +693,15 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
     for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
       const std::size_t i = idx[m];
       ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false, out.points[i].x};
+      if (m > 0 && m + 1 < idx.size()) {
+        // A top an earlier piece has already located (overlapping pieces): not located again.
+        const std::array<const continuation::BranchPoint*, 3> top = {&out.points[idx[m - 1]], &out.points[i],
+                                                                     &out.points[idx[m + 1]]};
+        const bool copy = std::any_of(out.peaks.begin(), out.peaks.end(), [&](const ResponsePeak& q) {
+          return q.piece != pc && is_sampled_top(q, top, out.results[i].amplitude, ao.x_scale, ao.lambda_scale);
+        });
+        if (copy) continue;
+      }
       if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
         int evaluations = 0;
         continuation::ScaledSystem sys(equations, ao, &evaluations);

@@ -15,6 +15,7 @@
 //                  and never above the largest step, 0.5 units: at least 200 points span the
 //                  range.
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -84,10 +85,20 @@ struct ResponsePeak {
   Eigen::VectorXd x;     ///< the solution (contact motion) there
 };
 
-/// The peaks by frequency, each resonance once: two located peaks within 1e-6 frequency units
+/// The peaks by frequency, each resonance once: two located peaks within 1e-4 frequency units
 /// and 1e-9 of each other's amplitude are one peak found twice (a piece that passes over it
-/// again after folds, or two overlapping pieces); the first is kept.
+/// again after folds); the first is kept. (Overlapping pieces: is_sampled_top.)
 std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double frequency_unit_hz);
+
+/// Whether `peak`, a maximum located on another piece, is the top that a piece samples at the
+/// three points `top` (its sampled maximum in the middle, of amplitude `sampled_amplitude`):
+/// two pieces that overlap trace the same top, and it is located once. True when the peak lies
+/// within a quarter of the longer of the two steps from the polyline through the three points,
+/// in the scaled variables (x / x_scale, lambda / lambda_scale), and is at least as high as
+/// the sampled maximum (to 1e-6 of it: the tracing corrector's precision). A distinct top that
+/// close would be one the curve cannot resolve at its own step.
+bool is_sampled_top(const ResponsePeak& peak, const std::array<const continuation::BranchPoint*, 3>& top,
+                    double sampled_amplitude, const Eigen::VectorXd& x_scale, double lambda_scale);
 
 struct FrequencyResponse;
 

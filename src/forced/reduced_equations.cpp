@@ -362,11 +362,13 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
     preconditioner_.factorize(Ad);
     ++stats_.dense_factorizations;
     // With the factors of this very matrix GMRES needs a few iterations (single precision
-    // against double); if even that fails (A too ill-conditioned for single precision), a
-    // direct solve in double answers.
-    const linalg::GmresResult g = linalg::gmres(op, precondition, b, d, gmres_options);
-    ok = g.converged;
-    stats_.krylov_iterations += g.iterations;
+    // against double); if even that fails (A too ill-conditioned for single precision, or a
+    // pivot exactly zero in it), a direct solve in double answers.
+    if (preconditioner_.nonsingular()) {
+      const linalg::GmresResult g = linalg::gmres(op, precondition, b, d, gmres_options);
+      ok = g.converged;
+      stats_.krylov_iterations += g.iterations;
+    }
     if (ok) {
       ++stats_.krylov_solves;
     } else {

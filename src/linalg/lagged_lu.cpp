@@ -4,6 +4,8 @@ namespace shroudsim::linalg {
 
 void LaggedLuPreconditioner::factorize(const Eigen::MatrixXd& A) {
   lu_.compute(A.cast<float>());
+  // An exactly zero pivot stays in U (Eigen's partial pivoting does not stop there).
+  nonsingular_ = (lu_.matrixLU().diagonal().array() != 0.0f).all();
   iterations_since_factor_ = 0;
   valid_ = true;
   renew_ = false;

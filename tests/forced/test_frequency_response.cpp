@@ -4,6 +4,8 @@
 // count.
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -249,6 +251,39 @@ TEST(FrequencyResponse, APeakFoundTwiceIsReportedOnce) {
   EXPECT_FALSE(d[1].located);
   EXPECT_EQ(d[2].point, 9u);
   EXPECT_EQ(d[3].point, 90u);
+}
+
+TEST(FrequencyResponse, APeakLocatedOnAnOverlappingPieceIsRecognisedOnTheOthersTop) {
+  // A piece samples a top at three points (unit scales); peaks located on another piece.
+  auto point = [](double lambda, double x) {
+    continuation::BranchPoint p;
+    p.lambda = lambda;
+    p.x = Eigen::VectorXd::Constant(1, x);
+    return p;
+  };
+  const continuation::BranchPoint a = point(99.0, 0.90), b = point(100.0, 1.00), c = point(101.0, 0.92);
+  const std::array<const continuation::BranchPoint*, 3> top = {&a, &b, &c};
+  const Eigen::VectorXd unit = Eigen::VectorXd::Ones(1);
+  auto peak = [](double lambda, double x, double amplitude, bool located) {
+    ResponsePeak p;
+    p.frequency_hz = lambda;
+    p.amplitude_m = amplitude;
+    p.located = located;
+    p.x = Eigen::VectorXd::Constant(1, x);
+    return p;
+  };
+  // The steps are ~1 long: the top located 0.1 beside the sampled maximum, higher than it.
+  EXPECT_TRUE(is_sampled_top(peak(100.1, 1.01, 1.01, true), top, 1.0, unit, 1.0));
+  // The same with the frequency in a unit of 0.5: the steps double, the peak stays by the polyline.
+  EXPECT_TRUE(is_sampled_top(peak(100.1, 1.01, 1.01, true), top, 1.0, unit, 0.5));
+  // Lower than the sampled maximum (beyond the corrector's precision): another top.
+  EXPECT_FALSE(is_sampled_top(peak(100.1, 1.01, 0.999, true), top, 1.0, unit, 1.0));
+  // Higher, but 0.3 steps off the polyline (in x): another top.
+  EXPECT_FALSE(is_sampled_top(peak(100.0, 1.3, 1.3, true), top, 1.0, unit, 1.0));
+  // Beyond the bracket: another top.
+  EXPECT_FALSE(is_sampled_top(peak(101.5, 0.95, 1.01, true), top, 1.0, unit, 1.0));
+  // A sampled maximum (not located) is never taken for a top.
+  EXPECT_FALSE(is_sampled_top(peak(100.1, 1.01, 1.01, false), top, 1.0, unit, 1.0));
 }
 
 }  // namespace

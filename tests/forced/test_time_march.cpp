@@ -3,6 +3,8 @@
 // balance against it (Jenkins element; full-3D contact that separates over part of the period).
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+
 #include <cmath>
 #include <complex>
 #include <numbers>

@@ -2,6 +2,8 @@
 // (forced/mode_synthesis.hpp) against closed forms and against the full harmonic balance.
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+
 #include <chrono>
 #include <cmath>
 #include <numbers>

@@ -4,6 +4,8 @@
 // the contact springs.
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <cmath>
