@@ -694,11 +694,12 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
       const std::size_t i = idx[m];
       ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false, out.points[i].x};
       if (m > 0 && m + 1 < idx.size()) {
-        // A top an earlier piece has already located (overlapping pieces): not located again.
+        // A top the curve has already passed over and located (a piece that turns back over
+        // it, or an earlier piece that overlaps this one): not located again.
         const std::array<const continuation::BranchPoint*, 3> top = {&out.points[idx[m - 1]], &out.points[i],
                                                                      &out.points[idx[m + 1]]};
         const bool copy = std::any_of(out.peaks.begin(), out.peaks.end(), [&](const ResponsePeak& q) {
-          return q.piece != pc && is_sampled_top(q, top, out.results[i].amplitude, ao.x_scale, ao.lambda_scale);
+          return is_sampled_top(q, top, out.results[i].amplitude, ao.x_scale, ao.lambda_scale);
         });
         if (copy) continue;
       }

@@ -87,12 +87,14 @@ struct ResponsePeak {
 
 /// The peaks by frequency, each resonance once: two located peaks within 1e-4 frequency units
 /// and 1e-9 of each other's amplitude are one peak found twice (a piece that passes over it
-/// again after folds); the first is kept. (Overlapping pieces: is_sampled_top.)
+/// again after folds, each copy located from its own sampled top); the first is kept. A top
+/// passed again is usually not located twice (is_sampled_top).
 std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double frequency_unit_hz);
 
-/// Whether `peak`, a maximum located on another piece, is the top that a piece samples at the
-/// three points `top` (its sampled maximum in the middle, of amplitude `sampled_amplitude`):
-/// two pieces that overlap trace the same top, and it is located once. True when the peak lies
+/// Whether `peak`, a maximum located earlier, is the top that the curve samples again at the
+/// three points `top` (a sampled maximum in the middle, of amplitude `sampled_amplitude`): a
+/// piece that turns back over a top, or two pieces that overlap, pass it twice, and it is
+/// located once. True when the peak lies
 /// within a quarter of the longer of the two steps from the polyline through the three points,
 /// in the scaled variables (x / x_scale, lambda / lambda_scale), and is at least as high as
 /// the sampled maximum (to 1e-6 of it: the tracing corrector's precision). A distinct top that

@@ -253,8 +253,8 @@ TEST(FrequencyResponse, APeakFoundTwiceIsReportedOnce) {
   EXPECT_EQ(d[3].point, 90u);
 }
 
-TEST(FrequencyResponse, APeakLocatedOnAnOverlappingPieceIsRecognisedOnTheOthersTop) {
-  // A piece samples a top at three points (unit scales); peaks located on another piece.
+TEST(FrequencyResponse, ATopPassedAgainIsRecognisedFromItsLocatedPeak) {
+  // The curve samples a top at three points (unit scales); peaks located on an earlier pass.
   auto point = [](double lambda, double x) {
     continuation::BranchPoint p;
     p.lambda = lambda;
