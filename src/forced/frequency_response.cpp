@@ -693,17 +693,19 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
     for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
       const std::size_t i = idx[m];
       ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false, out.points[i].x};
-      if (m > 0 && m + 1 < idx.size()) {
+      const bool inner = m > 0 && m + 1 < idx.size();
+      // The sampled maximum with the points beside it (inner maxima only).
+      std::array<const continuation::BranchPoint*, 3> pts{};
+      if (inner) {
+        pts = {&out.points[idx[m - 1]], &out.points[i], &out.points[idx[m + 1]]};
         // A top the curve has already passed over and located (a piece that turns back over
         // it, or an earlier piece that overlaps this one): not located again.
-        const std::array<const continuation::BranchPoint*, 3> top = {&out.points[idx[m - 1]], &out.points[i],
-                                                                     &out.points[idx[m + 1]]};
         const bool copy = std::any_of(out.peaks.begin(), out.peaks.end(), [&](const ResponsePeak& q) {
-          return is_sampled_top(q, top, out.results[i].amplitude, ao.x_scale, ao.lambda_scale);
+          return is_sampled_top(q, pts, out.results[i].amplitude, ao.x_scale, ao.lambda_scale);
         });
         if (copy) continue;
       }
-      if (settings.locate_peaks && m > 0 && m + 1 < idx.size()) {
+      if (settings.locate_peaks && inner) {
         int evaluations = 0;
         continuation::ScaledSystem sys(equations, ao, &evaluations);
         continuation::ArclengthOptions fine = ao;
@@ -715,8 +717,6 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
         };
         // On the two steps beside the sampled maximum, each parametrized by the arclength
         // along the tangent of its first point.
-        const std::array<const continuation::BranchPoint*, 3> pts = {&out.points[idx[m - 1]], &out.points[i],
-                                                                     &out.points[idx[m + 1]]};
         std::array<double, 2> lengths{0.0, 0.0};
         continuation::Extremum best;
         int found_evaluations = 0;

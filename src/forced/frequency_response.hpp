@@ -94,11 +94,11 @@ std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double
 /// Whether `peak`, a maximum located earlier, is the top that the curve samples again at the
 /// three points `top` (a sampled maximum in the middle, of amplitude `sampled_amplitude`): a
 /// piece that turns back over a top, or two pieces that overlap, pass it twice, and it is
-/// located once. True when the peak lies
-/// within a quarter of the longer of the two steps from the polyline through the three points,
-/// in the scaled variables (x / x_scale, lambda / lambda_scale), and is at least as high as
-/// the sampled maximum (to 1e-6 of it: the tracing corrector's precision). A distinct top that
-/// close would be one the curve cannot resolve at its own step.
+/// located once. True when the peak lies within a quarter of the longer of the two steps from
+/// the polyline through the three points, in the scaled variables (x / x_scale,
+/// lambda / lambda_scale), and is at least as high as the sampled maximum (to 1e-6 of it: the
+/// tracing corrector's precision). A distinct top that close would be one the curve cannot
+/// resolve at its own step.
 bool is_sampled_top(const ResponsePeak& peak, const std::array<const continuation::BranchPoint*, 3>& top,
                     double sampled_amplitude, const Eigen::VectorXd& x_scale, double lambda_scale);
 
