@@ -700,8 +700,18 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
         pts = {&out.points[idx[m - 1]], &out.points[i], &out.points[idx[m + 1]]};
         // A top the curve has already passed over and located (a piece that turns back over
         // it, or an earlier piece that overlaps this one): not located again.
+        // The geometric test picks the candidates; the corrector confirms that the located peak
+        // is a solution of the branch these three points sample (a twin branch a sample away
+        // stays at its own distance), as closes_loop does for a closed loop.
+        constexpr double kSameBranchTolerance = 100.0;  // in units of the tracing tolerance
         const bool copy = std::any_of(out.peaks.begin(), out.peaks.end(), [&](const ResponsePeak& q) {
-          return is_sampled_top(q, pts, out.results[i].amplitude, ao.x_scale, ao.lambda_scale);
+          if (!is_sampled_top(q, pts, out.results[i].amplitude, ao.x_scale, ao.lambda_scale)) return false;
+          continuation::BranchPoint located;
+          located.x = q.x;
+          located.lambda = q.frequency_hz;
+          const std::vector<continuation::BranchPoint> sampled{*pts[0], *pts[1], *pts[2]};
+          return continuation::distance_to_branch(equations, ao, sampled, located) <=
+                 kSameBranchTolerance * ao.tolerance;
         });
         if (copy) continue;
       }

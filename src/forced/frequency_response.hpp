@@ -98,7 +98,9 @@ std::vector<ResponsePeak> distinct_peaks(std::vector<ResponsePeak> peaks, double
 /// the polyline through the three points, in the scaled variables (x / x_scale,
 /// lambda / lambda_scale), and is at least as high as the sampled maximum (to 1e-6 of it: the
 /// tracing corrector's precision). A distinct top that close would be one the curve cannot
-/// resolve at its own step.
+/// resolve at its own step. This is the geometric pre-filter; analyse_and_locate_peaks then
+/// confirms with the corrector (continuation::distance_to_branch) that the peak is a solution
+/// of the branch the three points sample.
 bool is_sampled_top(const ResponsePeak& peak, const std::array<const continuation::BranchPoint*, 3>& top,
                     double sampled_amplitude, const Eigen::VectorXd& x_scale, double lambda_scale);
 

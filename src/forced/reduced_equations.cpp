@@ -117,38 +117,118 @@ const ReducedEquations::Harmonics& ReducedEquations::harmonics(double frequency_
   log::Stopwatch clock;
   const int h = contacts_.pair_layout().n_harmonics();
   const double w = kTwoPi * frequency_hz;
+  // The factored form when the linear part has one (the modal sector): G_n is then never
+  // formed per frequency, only where a dense Jacobian is factorized.
+  frf::FactoredReceptance probe;
+  const bool factored = linear_.factored_harmonic(0, w, false, probe);
+  if (factored) {
+    const bool fresh = harmonics_.frequency_hz != frequency_hz;
+    Harmonics& hs = harmonics_;
+    hs.g.factored = hs.dg.factored = true;
+    hs.g.dense.clear();
+    hs.dg.dense.clear();
+    hs.g.factors.resize(h + 1);
+    hs.dg.factors.resize(h + 1);
+    hs.w_lin.resize(h + 1);
+    hs.dw_lin.resize(h + 1);
+    for (int n = 0; n <= h; ++n) {
+      frf::FactoredReceptance& f = hs.g.factors[n];
+      linear_.factored_harmonic(n, w, derivative, f);
+      hs.w_lin[n] = f.w_lin;
+      if (derivative) {
+        frf::FactoredReceptance& df = hs.dg.factors[n];
+        df.flex = nullptr;  // the massless part does not depend on the frequency
+        df.psi = f.psi;
+        df.s = f.ds;
+        hs.dw_lin[n] = f.dw_lin;
+      }
+    }
+    if (fresh) {
+      hs.g_dense.clear();
+      hs.w_static = times(hs.g, 0, static_contact_load());
+    }
+    hs.frequency_hz = frequency_hz;
+    hs.derivative = derivative;
+    stats_.receptance_seconds += clock.seconds();
+    return harmonics_;
+  }
   if (harmonics_.frequency_hz != frequency_hz) {
-    harmonics_.g.resize(h + 1);
+    harmonics_.g.factored = harmonics_.dg.factored = false;
+    harmonics_.g.dense.resize(h + 1);
     harmonics_.w_lin.resize(h + 1);
     frf::HarmonicReceptance rec;
     for (int n = 0; n <= h; ++n) {
       linear_.harmonic(n, w, rec);
-      harmonics_.g[n] = std::move(rec.G);
+      harmonics_.g.dense[n] = std::move(rec.G);
       harmonics_.w_lin[n] = std::move(rec.w_lin);
     }
-    harmonics_.w_static = harmonics_.g[0] * static_contact_load();
+    harmonics_.g_dense.clear();
+    harmonics_.w_static = harmonics_.g.dense[0] * static_contact_load();
     harmonics_.frequency_hz = frequency_hz;
     harmonics_.derivative = false;
   }
   if (derivative) {
-    harmonics_.dg.resize(h + 1);
+    harmonics_.dg.dense.resize(h + 1);
     harmonics_.dw_lin.resize(h + 1);
-    for (int n = 0; n <= h; ++n) linear_.harmonic_derivative(n, w, harmonics_.dg[n], harmonics_.dw_lin[n]);
+    for (int n = 0; n <= h; ++n) linear_.harmonic_derivative(n, w, harmonics_.dg.dense[n], harmonics_.dw_lin[n]);
     harmonics_.derivative = true;
   }
   stats_.receptance_seconds += clock.seconds();
   return harmonics_;
 }
 
-void ReducedEquations::apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v,
-                             Eigen::VectorXd& out) const {
+const std::vector<Eigen::MatrixXcd>& ReducedEquations::dense_receptances(double frequency_hz) {
+  const Harmonics& hs = harmonics(frequency_hz, false);
+  if (!hs.g.factored) return hs.g.dense;
+  if (harmonics_.g_dense.empty()) {
+    log::Stopwatch clock;
+    harmonics_.g_dense = dense(hs.g);
+    stats_.receptance_seconds += clock.seconds();
+  }
+  return harmonics_.g_dense;
+}
+
+std::vector<Eigen::MatrixXcd> ReducedEquations::dense(const HarmonicMatrices& m) const {
+  if (!m.factored) return m.dense;
+  const int c = linear_.n_contact();
+  std::vector<Eigen::MatrixXcd> out(m.factors.size());
+  for (std::size_t n = 0; n < m.factors.size(); ++n) {
+    const frf::FactoredReceptance& f = m.factors[n];
+    if (f.flex) out[n] = f.flex->topLeftCorner(c, c).selfadjointView<Eigen::Lower>();
+    else out[n] = Eigen::MatrixXcd::Zero(c, c);
+    if (f.psi && f.s.size() > 0) {
+      const auto psi = f.psi->topRows(c);
+      out[n].noalias() += psi * f.s.asDiagonal() * psi.adjoint();
+    }
+  }
+  return out;
+}
+
+Eigen::VectorXcd ReducedEquations::times(const HarmonicMatrices& m, int n, const Eigen::VectorXcd& z) const {
+  if (!m.factored) return m.dense[static_cast<std::size_t>(n)] * z;
+  const int c = linear_.n_contact();
+  const frf::FactoredReceptance& f = m.factors[static_cast<std::size_t>(n)];
+  Eigen::VectorXcd y = Eigen::VectorXcd::Zero(c);
+  // F is Hermitian: its lower triangle is half the memory traffic of the full product (the
+  // products with F are a good part of a GMRES iteration on many pairs).
+  if (f.flex) y.noalias() = f.flex->topLeftCorner(c, c).selfadjointView<Eigen::Lower>() * z;
+  if (f.psi && f.s.size() > 0) {
+    const auto psi = f.psi->topRows(c);
+    const Eigen::VectorXcd modal = f.s.cwiseProduct(psi.adjoint() * z);
+    y.noalias() += psi * modal;
+  }
+  return y;
+}
+
+void ReducedEquations::apply(const HarmonicMatrices& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const {
   out.setZero(size());
-  for (std::size_t n = 0; n < m.size(); ++n)
-    add_harmonic(m[n] * complex_harmonic(v, static_cast<int>(n)), static_cast<int>(n), out);
+  const std::size_t count = m.factored ? m.factors.size() : m.dense.size();
+  for (std::size_t n = 0; n < count; ++n)
+    add_harmonic(times(m, static_cast<int>(n), complex_harmonic(v, static_cast<int>(n))), static_cast<int>(n), out);
 }
 
 void ReducedEquations::jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks, Eigen::MatrixXd& J) {
-  jacobian_from(harmonics(frequency_hz, false).g, blocks, J);
+  jacobian_from(dense_receptances(frequency_hz), blocks, J);
 }
 
 void ReducedEquations::jacobian_from(const std::vector<Eigen::MatrixXcd>& g_n,
@@ -276,7 +356,7 @@ bool ReducedEquations::evaluate_impl(const Eigen::VectorXd& w, double frequency_
       add_harmonic(-excitation_scale_ * hs.dw_lin[static_cast<std::size_t>(n)], n, *dr_dlambda);
     *dr_dlambda *= kTwoPi;  // d/df = 2 pi d/dw
   }
-  if (J) jacobian_from(hs.g, blocks_, *J);
+  if (J) jacobian_from(dense_receptances(frequency_hz), blocks_, *J);
   if (linearize) {  // the factors solve_bordered() multiplies with
     jac_g_ = hs.g;
     jac_blocks_ = blocks_;
@@ -354,7 +434,7 @@ bool ReducedEquations::solve_bordered(const continuation::BorderedMatrix& A, con
   if (!ok) {
     // New preconditioner: the dense bordered matrix at this linearization, factorized.
     Eigen::MatrixXd J;
-    jacobian_from(jac_g_, jac_blocks_, J);
+    jacobian_from(dense(jac_g_), jac_blocks_, J);
     Eigen::MatrixXd Ad(n + 1, n + 1);
     Ad.topLeftCorner(n, n).noalias() = A.r_scale.cwiseInverse().asDiagonal() * J * A.x_scale.asDiagonal();
     Ad.col(n).head(n) = A.column;
@@ -387,7 +467,12 @@ Eigen::VectorXd ReducedEquations::linear_motion(double frequency_hz) const {
   const int h = contacts_.pair_layout().n_harmonics();
   Eigen::VectorXd w_lin = Eigen::VectorXd::Zero(size());
   frf::HarmonicReceptance rec;
+  frf::FactoredReceptance factored;
   for (int n = 0; n <= h; ++n) {
+    if (linear_.factored_harmonic(n, kTwoPi * frequency_hz, false, factored)) {  // without forming G_n
+      add_harmonic(factored.w_lin, n, w_lin);
+      continue;
+    }
     linear_.harmonic(n, kTwoPi * frequency_hz, rec);
     add_harmonic(rec.w_lin, n, w_lin);
   }
@@ -432,21 +517,23 @@ PointResult ReducedEquations::analyse(const Eigen::VectorXd& w, double frequency
   const hbm::EvaluationStatus status = contacts_.evaluate(w, f_, nullptr);
   res.unconverged_pairs = status.unconverged_pairs;
   const double omega = kTwoPi * frequency_hz;
-  std::vector<frf::HarmonicReceptance> rec(h + 1);
-  for (int n = 0; n <= h; ++n) linear_.harmonic(n, omega, rec[n]);
+  // The response rows only (the contact block G_n is not needed here).
+  std::vector<Eigen::MatrixXcd> resp(h + 1);
+  std::vector<Eigen::VectorXcd> u_lin(h + 1);
+  for (int n = 0; n <= h; ++n) linear_.response_harmonic(n, omega, resp[n], u_lin[n]);
   std::vector<Eigen::VectorXcd> u(h + 1), forces(h + 1);
   res.harmonic_amplitudes.resize(h + 1);
   const Eigen::VectorXcd f_static = static_contact_load();
   for (int n = 0; n <= h; ++n) {
     forces[n] = complex_harmonic(f_, n);
     // The response about the static state (its own load F_s excluded from the static part).
-    u[n] = rec[n].u_lin - rec[n].H * (n == 0 ? Eigen::VectorXcd(forces[n] - f_static) : forces[n]);
+    u[n] = u_lin[n] - resp[n] * (n == 0 ? Eigen::VectorXcd(forces[n] - f_static) : forces[n]);
     res.harmonic_amplitudes[n] = u[n].norm();
   }
   // max over one period of |u(t)|, u(t) = Re sum_n U_n exp(i n theta).
   res.amplitude = peak_norm(u, time_points);
   if (h >= 1) {  // free response: harmonic 1 only, no contact forces
-    std::vector<Eigen::VectorXcd> free = {Eigen::VectorXcd::Zero(rec[1].u_lin.size()), rec[1].u_lin};
+    std::vector<Eigen::VectorXcd> free = {Eigen::VectorXcd::Zero(u_lin[1].size()), u_lin[1]};
     res.linear_amplitude = peak_norm(free, time_points);
   }
   linear_.energy(omega, forces, res.excitation_work, res.viscous_dissipation);

@@ -28,6 +28,13 @@
 // solution is checked by its true residual, ||A d - b|| <= krylov_tolerance ||b||, in
 // double precision.
 //
+// The receptances: where the linear part has a factored form (the modal sector,
+// frf::FactoredReceptance: G_n = F_n + Psi_n diag(s_n(w)) Psi_n^H, F_n the massless residual
+// or static flexibility), a new frequency costs O(modes) per harmonic, products cost
+// O(c^2 + c modes), and G_n is formed densely (O(c^2 modes)) only where a dense Jacobian is
+// formed: to renew the preconditioner, or below krylov_min_size. dG_n/dw = Psi_n diag(ds_n)
+// Psi_n^H is never formed.
+//
 // The residual also gives dr/df (f the frequency in Hz) from the linear part's exact
 // frequency derivative (no extra contact evaluations), and repeats of an evaluation at the
 // same (W, f) (the continuation evaluates the converged point twice) are served from a copy.
@@ -144,16 +151,31 @@ class ReducedEquations : public continuation::ParametricResidual {
   std::vector<Eigen::MatrixXd> contact_jacobian(const Eigen::VectorXd& w);
 
  private:
-  /// The complex G_n (c x c) and W_lin,n (c) of every harmonic at one frequency (and, when
-  /// asked, their derivatives d/dw), kept until the frequency changes.
+  /// The complex matrices M_n (c x c) of every harmonic, n = 0..H: dense, or in the linear
+  /// part's factored form F_n + Psi_n diag(s_n) Psi_n^H (frf::FactoredReceptance), which is
+  /// multiplied without forming M_n and formed densely only where a dense Jacobian is needed.
+  struct HarmonicMatrices {
+    std::vector<Eigen::MatrixXcd> dense;           ///< when not factored
+    std::vector<frf::FactoredReceptance> factors;  ///< when factored (s the modal factors)
+    bool factored = false;
+  };
+  /// G_n and W_lin,n of every harmonic at one frequency (and, when asked, their derivatives
+  /// d/dw: dG_n = Psi_n diag(ds_n) Psi_n^H in factored form), kept until the frequency changes.
   struct Harmonics {
     double frequency_hz = -1.0;
     bool derivative = false;
-    std::vector<Eigen::MatrixXcd> g, dg;
+    HarmonicMatrices g, dg;
+    std::vector<Eigen::MatrixXcd> g_dense;  ///< G_n formed from a factored g, on demand
     std::vector<Eigen::VectorXcd> w_lin, dw_lin;
     Eigen::VectorXcd w_static;  ///< G_0 F_s: the static state's relative displacement (c)
   };
   const Harmonics& harmonics(double frequency_hz, bool derivative);
+  /// The dense G_n of harmonics(frequency_hz) (formed once per frequency when factored).
+  const std::vector<Eigen::MatrixXcd>& dense_receptances(double frequency_hz);
+  /// M_n densely.
+  std::vector<Eigen::MatrixXcd> dense(const HarmonicMatrices& m) const;
+  /// M_n z (c-vector).
+  Eigen::VectorXcd times(const HarmonicMatrices& m, int n, const Eigen::VectorXcd& z) const;
   /// F_s (c, real): the contact forces of the static state the model is written about, the
   /// normal max(0, N0) of every pair with PairParameters::preload_in_equilibrium, else 0.
   Eigen::VectorXcd static_contact_load() const;
@@ -167,7 +189,7 @@ class ReducedEquations : public continuation::ParametricResidual {
   /// out += the evaluator-layout vector whose harmonic n is z (c-vector).
   void add_harmonic(const Eigen::VectorXcd& z, int n, Eigen::VectorXd& out) const;
   /// out = sum_n M_n v_n (M = g or dg of h): a block-diagonal-over-harmonics product.
-  void apply(const std::vector<Eigen::MatrixXcd>& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
+  void apply(const HarmonicMatrices& m, const Eigen::VectorXd& v, Eigen::VectorXd& out) const;
   bool evaluate_impl(const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& r, Eigen::MatrixXd* J,
                      Eigen::VectorXd* dr_dlambda, bool linearize);
   /// y = (I + G D) z with the G_n and D_p of the last Jacobian evaluation: O(n b + c^2 H).
@@ -190,7 +212,7 @@ class ReducedEquations : public continuation::ParametricResidual {
     Eigen::MatrixXd J;
   } previous_;
   // The factors of the last Jacobian evaluation, for products with J without the dense J.
-  std::vector<Eigen::MatrixXcd> jac_g_;
+  HarmonicMatrices jac_g_;
   std::vector<Eigen::MatrixXd> jac_blocks_;
   bool jac_valid_ = false;
   // Lagged preconditioner: single-precision LU factors of an earlier bordered matrix.

@@ -5,6 +5,13 @@
 
 namespace shroudsim::frf {
 
+void LinearPart::response_harmonic(int n, double w, Eigen::MatrixXcd& H, Eigen::VectorXcd& u_lin) const {
+  HarmonicReceptance rec;
+  harmonic(n, w, rec);
+  H = std::move(rec.H);
+  u_lin = std::move(rec.u_lin);
+}
+
 void LinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const {
   // Relative to w, whatever its unit (a floor in rad/s would be a coarse step at 0.01 Hz).
   const double h = w != 0.0 ? 1e-6 * std::abs(w) : 1e-6;

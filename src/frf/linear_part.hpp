@@ -56,6 +56,21 @@ struct HarmonicReceptance {
   Eigen::VectorXcd u_lin;  ///< d
 };
 
+/// G_n of harmonic n at one frequency in factored form, for products with vectors without
+/// forming the c x c matrix:
+///   G_n = F + Psi diag(s) Psi^H,   F and Psi independent of the frequency,
+/// F (c x c, massless: residual or static flexibility, Hermitian: stored in full, exactly
+/// Hermitian, and only its lower triangle is read) the top-left c x c block of *flex
+/// (nullptr: no such part), Psi the top c rows of *psi (c x modes; nullptr: no modes), both
+/// owned by the linear part and valid for its life; s the modal factors at W = n w. With the
+/// derivative, ds = d s / dw (w the fundamental [rad/s]): dG_n/dw = Psi diag(ds) Psi^H.
+struct FactoredReceptance {
+  const Eigen::MatrixXcd* flex = nullptr;
+  const Eigen::MatrixXcd* psi = nullptr;
+  Eigen::VectorXcd s, ds;
+  Eigen::VectorXcd w_lin, dw_lin;  ///< w_lin,n (c) and d/dw of it (with the derivative)
+};
+
 class LinearPart {
  public:
   virtual ~LinearPart() = default;
@@ -70,6 +85,17 @@ class LinearPart {
   /// difference of harmonic() (step 1e-6 w, relative); the lumped and the modal (sector)
   /// models override it exactly.
   virtual void harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const;
+  /// H_n and u_lin,n only (the response at a solution: U_n = u_lin,n - H_n F_n), without G_n.
+  /// The default calls harmonic(); a model where G_n is the costly part overrides it.
+  virtual void response_harmonic(int n, double w, Eigen::MatrixXcd& H, Eigen::VectorXcd& u_lin) const;
+  /// G_n (and w_lin,n; with `derivative` their d/dw) in factored form (FactoredReceptance):
+  /// a model whose G_n is a low-rank modal part plus a frequency-independent one answers true,
+  /// and products G_n v then cost O(c modes + c^2) without the O(c^2 modes) of forming G_n.
+  /// false (the default): only harmonic() is available.
+  virtual bool factored_harmonic(int n, double w, bool derivative, FactoredReceptance& out) const {
+    (void)n, (void)w, (void)derivative, (void)out;
+    return false;
+  }
   /// Work of the excitation per fundamental period [J] and viscous dissipation per period
   /// [J], given the complex contact forces F_n (n = 0..H, each of size c) at frequency w.
   virtual void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,

@@ -8,9 +8,17 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
+#include "linalg/parallel.hpp"
 
 namespace shroudsim::frf {
 namespace {
+/// A <- (A + A^H) / 2: exactly Hermitian (C K^-1 C^H is, but its computed form only to
+/// round-off), so that a product may read one triangle (FactoredReceptance).
+void make_hermitian(Eigen::MatrixXcd& a) {
+  const Eigen::MatrixXcd h = 0.5 * (a + a.adjoint());
+  a = h;
+}
 
 using Complex = std::complex<double>;
 
@@ -57,7 +65,8 @@ int SectorLinearPart::harmonic_index(int n) const { return frf::harmonic_index(n
 
 SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
                                    const std::function<modal::StiffnessFactor(int)>& factor,
-                                   std::vector<SectorContactPair> pairs, SectorForcing forcing, int n_harmonics)
+                                   std::vector<SectorContactPair> pairs, SectorForcing forcing, int n_harmonics,
+                                   int threads)
     : pairs_(std::move(pairs)), forcing_(forcing), sectors_(sector.sectors()), n_harmonics_(n_harmonics) {
   SHROUDSIM_CHECK(forcing_.excitation_node >= 0 && forcing_.response_node >= 0, "excitation and response nodes set");
   std::set<int> needed;
@@ -68,8 +77,7 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
   // would be n x k complex, 2.6 GB on a 238k-DOF sector with 227 pairs (and CHOLMOD copies
   // it twice more), where a block of 64 columns is 0.24 GB.
   constexpr Eigen::Index kFlexibilityBlock = 64;
-  auto static_flexibility = [&](int h, const Eigen::SparseMatrix<Complex>& ct) {
-    const modal::StiffnessFactor k = factor(h);
+  auto static_flexibility = [&](const modal::StiffnessFactor& k, const Eigen::SparseMatrix<Complex>& ct) {
     const Eigen::SparseMatrix<Complex> cth = ct.adjoint();
     Eigen::MatrixXcd flex(ct.rows(), ct.rows());
     for (Eigen::Index j0 = 0; j0 < cth.cols(); j0 += kFlexibilityBlock) {
@@ -86,38 +94,91 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
     const Eigen::SparseMatrix<Complex> t = sector.expansion(h);
     return Eigen::SparseMatrix<Complex>(c * t);
   };
-  {
-    const Eigen::SparseMatrix<Complex> ct = projected(0);
-    static_.flex = static_flexibility(0, ct);
-    // With the modes of index 0 at hand, harmonic 0's second-order form is dynamic (the
-    // Floquet analysis: a perturbation's mean oscillates at lambda, not at 0).
-    if (auto it = bases.find(0); it != bases.end()) {
-      static_.omega = it->second.omega;
-      static_.psi = ct * it->second.phi;
-    }
-  }
   // Every index with modes: the harmonic balance's h_n, then the further indices the Floquet
   // analysis's perturbation families need (perturbation_form).
   std::vector<int> indices(needed.begin(), needed.end());
   for (const auto& [h, b] : bases)
     if (needed.count(h) == 0) indices.push_back(h);
-  for (int h : indices) {
-    auto it = bases.find(h);
-    SHROUDSIM_CHECK(it != bases.end(), "modes of harmonic index " + std::to_string(h) + " given");
-    const modal::ModalBasis& b = it->second;
+  for (int h : indices) SHROUDSIM_CHECK(bases.count(h) == 1, "modes of harmonic index " + std::to_string(h) + " given");
+  // The work per index is one factorization of K_h and c + 4 solves with it. Index Nb - h is
+  // the complex conjugate of index h (K, C and the modes conjugated: the modal stage gives
+  // the modes of Nb - h as those of h conjugated), so its data is that of h conjugated, and
+  // the groups {h, Nb - h} (with index 0, whose static flexibility is always needed, in
+  // group 0) run in parallel, one factor each: the complex ones first, as they cost about
+  // twice the real ones (0 and Nb / 2). Each index's data is computed by the same operations
+  // whatever the thread count.
+  std::map<int, std::vector<int>> groups;  // canonical min(h, Nb - h) -> its indices
+  groups[0];
+  for (int h : indices) groups[std::min(h, (sectors_ - h) % sectors_)].push_back(h);
+  std::vector<std::pair<int, std::vector<int>>> jobs(groups.begin(), groups.end());
+  const auto is_real_index = [&](int canonical) { return canonical == 0 || 2 * canonical == sectors_; };
+  std::stable_sort(jobs.begin(), jobs.end(),
+                   [&](const auto& a, const auto& b) { return !is_real_index(a.first) && is_real_index(b.first); });
+  std::vector<std::vector<IndexData>> results(jobs.size());
+  std::vector<IndexTimes> times(jobs.size());
+  IndexData static_data;
+  auto index_data = [&](int h, const Eigen::SparseMatrix<Complex>& ct, const modal::StiffnessFactor* k) {
+    const modal::ModalBasis& b = bases.at(h);
     IndexData d;
     d.omega = b.omega;
-    const Eigen::SparseMatrix<Complex> ct = projected(h);
     d.psi = ct * b.phi;
-    if (forcing_.residual_flexibility) {
-      d.flex = static_flexibility(h, ct);
+    if (k) {
+      d.flex = static_flexibility(*k, ct);
       for (Eigen::Index r = 0; r < d.omega.size(); ++r)
         d.flex -= d.psi.col(r) * d.psi.col(r).adjoint() / (d.omega[r] * d.omega[r]);
+      make_hermitian(d.flex);
     } else {
       d.flex = Eigen::MatrixXcd::Zero(ct.rows(), ct.rows());
     }
-    dynamic_[h] = std::move(d);
-  }
+    return d;
+  };
+  linalg::parallel_for(static_cast<int>(jobs.size()), linalg::worker_count(threads, static_cast<int>(jobs.size())),
+                       [&](int j) {
+                         const auto& [canonical, members] = jobs[static_cast<std::size_t>(j)];
+                         // The factor of the group's first index (index 0 for the static group).
+                         const int first = canonical == 0 ? 0 : members.front();
+                         const bool need_factor = canonical == 0 || forcing_.residual_flexibility;
+                         log::Stopwatch clock;
+                         const modal::StiffnessFactor k_first = need_factor ? factor(first) : modal::StiffnessFactor();
+                         IndexTimes& t = times[static_cast<std::size_t>(j)];
+                         t.indices = members;
+                         if (canonical == 0 && (members.empty() || members.front() != 0))
+                           t.indices.insert(t.indices.begin(), 0);
+                         t.factor_seconds = clock.seconds();
+                         clock.restart();
+                         std::vector<IndexData>& out = results[static_cast<std::size_t>(j)];
+                         for (int h : members) {
+                           if (h != members.front()) {  // Nb - h: the data of h conjugated
+                             IndexData d;
+                             d.omega = out.front().omega;
+                             d.psi = out.front().psi.conjugate();
+                             d.flex = out.front().flex.conjugate();
+                             out.push_back(std::move(d));
+                             continue;
+                           }
+                           const Eigen::SparseMatrix<Complex> ct = projected(h);
+                           out.push_back(index_data(h, ct, forcing_.residual_flexibility ? &k_first : nullptr));
+                         }
+                         if (canonical == 0) {
+                           const Eigen::SparseMatrix<Complex> ct = projected(0);
+                           static_data.flex = static_flexibility(k_first, ct);
+                           make_hermitian(static_data.flex);
+                           // With the modes of index 0 at hand, harmonic 0's second-order form
+                           // is dynamic (the Floquet analysis: a perturbation's mean oscillates
+                           // at lambda, not at 0).
+                           if (auto it = bases.find(0); it != bases.end()) {
+                             static_data.omega = it->second.omega;
+                             static_data.psi = ct * it->second.phi;
+                           }
+                         }
+                         t.flexibility_seconds = clock.seconds();
+                       });
+  std::sort(times.begin(), times.end(),
+            [](const IndexTimes& a, const IndexTimes& b) { return a.indices.front() < b.indices.front(); });
+  build_times_ = std::move(times);
+  static_ = std::move(static_data);
+  for (std::size_t j = 0; j < jobs.size(); ++j)
+    for (std::size_t i = 0; i < jobs[j].second.size(); ++i) dynamic_[jobs[j].second[i]] = std::move(results[j][i]);
 }
 
 Eigen::MatrixXcd SectorLinearPart::receptance(int n, double w) const {
@@ -164,6 +225,59 @@ void SectorLinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG
   else dw_lin = Eigen::VectorXcd::Zero(c);
 }
 
+void SectorLinearPart::response_harmonic(int n, double w, Eigen::MatrixXcd& H, Eigen::VectorXcd& u_lin) const {
+  const int c = n_contact();
+  if (n == 0) {  // as harmonic(): the static flexibility's response rows, no static load
+    H = static_.flex.block(c, 0, 3, c);
+    u_lin = Eigen::VectorXcd::Zero(3);
+    return;
+  }
+  const IndexData& d = dynamic_.at(harmonic_index(n));
+  const double big_w = n * w, z = forcing_.damping_ratio;
+  Eigen::VectorXcd inv(d.omega.size());
+  for (Eigen::Index r = 0; r < d.omega.size(); ++r)
+    inv[r] = 1.0 / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+  // Rows c..c+2 of Q_n = Psi diag(inv) Psi^H + flex: columns 0..c-1 (H) and c+3 (u_lin).
+  const Eigen::MatrixXcd rows = d.psi.middleRows(c, 3) * inv.asDiagonal();
+  H = rows * d.psi.topRows(c).adjoint() + d.flex.block(c, 0, 3, c);
+  if (n == 1) u_lin = rows * d.psi.row(c + 3).adjoint() + d.flex.block(c, c + 3, 3, 1);
+  else u_lin = Eigen::VectorXcd::Zero(3);
+}
+
+bool SectorLinearPart::factored_harmonic(int n, double w, bool derivative, FactoredReceptance& out) const {
+  const int c = n_contact();
+  out.w_lin = Eigen::VectorXcd::Zero(c);
+  if (derivative) out.dw_lin = Eigen::VectorXcd::Zero(c);
+  if (n == 0) {  // the exact static flexibility, no modes (as receptance(0, w))
+    out.flex = &static_.flex;
+    out.psi = nullptr;
+    out.s.resize(0);
+    out.ds.resize(0);
+    return true;
+  }
+  const IndexData& d = dynamic_.at(harmonic_index(n));
+  out.flex = forcing_.residual_flexibility ? &d.flex : nullptr;
+  out.psi = &d.psi;
+  const double big_w = n * w, z = forcing_.damping_ratio;
+  const Eigen::Index modes = d.omega.size();
+  out.s.resize(modes);
+  if (derivative) out.ds.resize(modes);
+  for (Eigen::Index r = 0; r < modes; ++r) {
+    const Complex den(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+    out.s[r] = 1.0 / den;
+    // As harmonic_derivative: d/dw of 1/den at W = n w.
+    if (derivative) out.ds[r] = static_cast<double>(n) * Complex(2.0 * big_w, -2.0 * z * d.omega[r]) / (den * den);
+  }
+  if (n == 1) {  // the excitation column c + 3 of Q_1
+    const auto psi_c = d.psi.topRows(c);
+    const Eigen::VectorXcd excitation = d.psi.row(c + 3).adjoint();
+    out.w_lin.noalias() = psi_c * out.s.cwiseProduct(excitation);
+    if (forcing_.residual_flexibility) out.w_lin += d.flex.block(0, c + 3, c, 1);
+    if (derivative) out.dw_lin.noalias() = psi_c * out.ds.cwiseProduct(excitation);
+  }
+  return true;
+}
+
 void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
                               double& viscous_dissipation) const {
   constexpr double kPi = std::numbers::pi;
@@ -184,8 +298,12 @@ void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& for
       viscous_dissipation += kPi * static_cast<double>(n * n) * w * 2.0 * z * d.omega[r] * std::norm(q);
     }
     if (n == 1) {
-      const Complex u_e = (receptance(1, w) * g)[c + 3];  // E U_1: displacement along the force
-      excitation_work += kPi * (-u_e.imag());             // pi Im(1 * conj(U_e))
+      // E U_1, the displacement along the force: row c + 3 of Q_1 times g, i.e.
+      // psi_e diag(1 / den) Psi^H g + flex_e g (the modal loads p = Psi^H g from above).
+      Complex u_e = (d.flex.row(c + 3) * g).value();
+      for (Eigen::Index r = 0; r < d.omega.size(); ++r)
+        u_e += d.psi(c + 3, r) * p[r] / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+      excitation_work += kPi * (-u_e.imag());  // pi Im(1 * conj(U_e))
     }
   }
 }

@@ -65,9 +65,12 @@ class SectorLinearPart : public LinearPart {
   /// bases: the modes of every h_n needed (n = 0..H); factor(h): K_h factorization.
   /// Precomputes, per harmonic index, the projections of the modes on C and the static
   /// (residual) flexibility blocks: after construction each harmonic costs O(k^2 modes).
+  /// threads (0: all cores): the pairs of conjugate indices {h, Nb - h} are computed in
+  /// parallel, each with one factor: factor must then be safe to call from several threads
+  /// (it is called once per pair, for h <= Nb / 2 or for index 0).
   SectorLinearPart(const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
                    const std::function<modal::StiffnessFactor(int)>& factor, std::vector<SectorContactPair> pairs,
-                   SectorForcing forcing, int n_harmonics);
+                   SectorForcing forcing, int n_harmonics, int threads = 1);
 
   int n_contact() const override { return 3 * static_cast<int>(pairs_.size()); }
   int n_response() const override { return 3; }
@@ -75,6 +78,11 @@ class SectorLinearPart : public LinearPart {
   /// Exact: d/dw 1/(w_r^2 - W^2 + 2 i z w_r W) = n (2 W - 2 i z w_r) / (...)^2, W = n w; the
   /// residual and static flexibilities do not depend on the frequency.
   void harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const override;
+  /// The response rows of Q_n only: O(3 c modes) against the O(c^2 modes) of harmonic().
+  void response_harmonic(int n, double w, Eigen::MatrixXcd& H, Eigen::VectorXcd& u_lin) const override;
+  /// F the residual flexibility's contact block (nullptr without residual flexibility), or
+  /// for n = 0 the static flexibility with no modes; s_r = 1 / (w_r^2 - W^2 + 2 i z w_r W).
+  bool factored_harmonic(int n, double w, bool derivative, FactoredReceptance& out) const override;
   void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& excitation_work,
               double& viscous_dissipation) const override;
   std::string describe() const override;
@@ -100,6 +108,14 @@ class SectorLinearPart : public LinearPart {
   /// Harmonic index of temporal harmonic n.
   int harmonic_index(int n) const;
 
+  /// What the construction cost, per group of harmonic indices sharing one K_h factor.
+  struct IndexTimes {
+    std::vector<int> indices;          ///< index 0 (static flexibility) or h and Nb - h
+    double factor_seconds = 0.0;       ///< obtaining the factor (factor(h))
+    double flexibility_seconds = 0.0;  ///< the static / residual flexibility solves and projections
+  };
+  const std::vector<IndexTimes>& build_times() const { return build_times_; }
+
  private:
   struct IndexData {
     Eigen::VectorXd omega;  ///< modes kept [rad/s]
@@ -119,6 +135,7 @@ class SectorLinearPart : public LinearPart {
   int sectors_ = 1, n_harmonics_ = 0;
   std::map<int, IndexData> dynamic_;  ///< per harmonic index of n >= 1
   IndexData static_;                  ///< n = 0 (h = 0): exact static flexibility in flex
+  std::vector<IndexTimes> build_times_;
 };
 
 /// The loads of one operating deflection shape: fundamental circular frequency w [rad/s] and

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -20,6 +21,7 @@
 #include "frf/sector.hpp"
 #include "frf/static_shroud.hpp"
 #include "io/output.hpp"
+#include "modal/harmonic.hpp"
 #include "modal/rotating.hpp"
 #include "pipeline/forced_model.hpp"
 #include "pipeline/modal_stage.hpp"
@@ -159,11 +161,32 @@ ForcedModel make_sector_model(Context& ctx) {
   forcing.residual_flexibility = c.modal.residual_flexibility;
   log::Stopwatch clock;
   const cyclic::CyclicSector& sector = modal.cyclic();
-  model.linear = std::make_unique<frf::SectorLinearPart>(
-      sector, modal.bases, [&](int h) { return modal.stiffness_factor(h); }, pairs, forcing, c.hbm.harmonics);
+  // The K_h factors are computed in parallel (one per pair of conjugate indices): the map of
+  // factors the model keeps for the shapes is filled under a lock, each factorization outside it.
+  std::mutex factors_lock;
+  const auto factor = [&](int h) {
+    {
+      const std::lock_guard<std::mutex> g(factors_lock);
+      if (auto it = modal.factors.find(h); it != modal.factors.end()) return it->second;
+    }
+    const modal::StiffnessFactor k = modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method);
+    const std::lock_guard<std::mutex> g(factors_lock);
+    return modal.factors.emplace(h, k).first->second;
+  };
+  model.linear = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, factor, pairs, forcing, c.hbm.harmonics,
+                                                         ctx.threads);
   model.sector_pairs = pairs;
   model.sector_forcing = forcing;
   ctx.report.stage("receptances", clock.seconds());
+  if (log::detailed()) {
+    const auto& part = static_cast<const frf::SectorLinearPart&>(*model.linear);
+    for (const auto& t : part.build_times()) {
+      std::string ids;
+      for (int h : t.indices) ids += (ids.empty() ? "" : ", ") + std::to_string(h);
+      log::info("frf: receptances of harmonic indices " + ids + ": factor " + io::format_number(t.factor_seconds) +
+                " s, flexibility " + io::format_number(t.flexibility_seconds) + " s");
+    }
+  }
   auto& j = ctx.report.section("frf_model");
   j["contact_pairs"] = pairs.size();
   j["contact_discretization"] = frf::to_string(c.contact.discretization);

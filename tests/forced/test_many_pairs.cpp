@@ -231,19 +231,32 @@ struct Sector : testing_support::CoarseSector {
       factors[h] = r.stiffness.valid() ? r.stiffness : modal::factor_harmonic_stiffness(*sector, h);
     }
   }
-  frf::SectorLinearPart linear(bool residual) const {
+  frf::SectorLinearPart linear(bool residual, int threads = 1) const {
     std::vector<frf::SectorContactPair> pairs;
     for (const auto& [low, high] : mesh.shroud_pairs)
       pairs.push_back(testing_support::circumferential_pair(mesh, low, high));
     const frf::SectorForcing forcing = testing_support::test_forcing(mesh, residual);
     return frf::SectorLinearPart(
-        *sector, bases, [&](int h) { return factors.at(h); }, pairs, forcing, 2);
+        *sector, bases, [&](int h) { return factors.at(h); }, pairs, forcing, 2, threads);
   }
 };
 
 const Sector& sector() {
   static const Sector s;
   return s;
+}
+
+/// Every shroud pair of the sector with the same contact parameters.
+std::vector<contact::PairParameters> sector_pairs(bool preload_in_equilibrium) {
+  std::vector<contact::PairParameters> pairs(sector().mesh.shroud_pairs.size());
+  for (auto& p : pairs) {
+    p.tangential_stiffness = 2e5;
+    p.normal_stiffness = 2e5;
+    p.friction_coefficient = 0.3;
+    p.normal_preload = 0.05;
+    p.preload_in_equilibrium = preload_in_equilibrium;
+  }
+  return pairs;
 }
 
 TEST(ManyPairsSector, ExactFrequencyDerivativeOfTheModalReceptanceMatchesCentralDifferences) {
@@ -266,16 +279,104 @@ TEST(ManyPairsSector, ExactFrequencyDerivativeOfTheModalReceptanceMatchesCentral
   }
 }
 
+TEST(ManyPairsSector, FactoredReceptanceEqualsTheDenseOne) {
+  for (bool residual : {true, false}) {
+    const frf::SectorLinearPart part = sector().linear(residual);
+    const int c = part.n_contact();
+    const double w = 0.9 * sector().bases.at(1).omega[0];
+    for (int n : {0, 1, 2}) {
+      frf::HarmonicReceptance rec;
+      part.harmonic(n, w, rec);
+      Eigen::MatrixXcd dg;
+      Eigen::VectorXcd dw;
+      part.harmonic_derivative(n, w, dg, dw);
+      frf::FactoredReceptance f;
+      ASSERT_TRUE(part.factored_harmonic(n, w, true, f));
+      Eigen::MatrixXcd g = f.flex ? Eigen::MatrixXcd(f.flex->topLeftCorner(c, c)) : Eigen::MatrixXcd::Zero(c, c);
+      Eigen::MatrixXcd dg_f = Eigen::MatrixXcd::Zero(c, c);
+      if (f.psi) {
+        g += f.psi->topRows(c) * f.s.asDiagonal() * f.psi->topRows(c).adjoint();
+        dg_f = f.psi->topRows(c) * f.ds.asDiagonal() * f.psi->topRows(c).adjoint();
+      }
+      EXPECT_EQ(f.flex == nullptr, n > 0 && !residual) << "n " << n;
+      EXPECT_LE((g - rec.G).norm(), kRoundOff * rec.G.norm()) << "n " << n << " residual " << residual;
+      EXPECT_LE((f.w_lin - rec.w_lin).norm(), kRoundOff * std::max(rec.w_lin.norm(), 1e-300)) << "n " << n;
+      EXPECT_LE((dg_f - dg).norm(), kRoundOff * std::max(dg.norm(), 1e-300)) << "n " << n;
+      EXPECT_LE((f.dw_lin - dw).norm(), kRoundOff * std::max(dw.norm(), 1e-300)) << "n " << n;
+      // The response rows alone, as analyse() takes them.
+      Eigen::MatrixXcd h_rows;
+      Eigen::VectorXcd u_lin;
+      part.response_harmonic(n, w, h_rows, u_lin);
+      EXPECT_LE((h_rows - rec.H).norm(), kRoundOff * rec.H.norm()) << "n " << n;
+      EXPECT_LE((u_lin - rec.u_lin).norm(), kRoundOff * std::max(rec.u_lin.norm(), 1e-300)) << "n " << n;
+    }
+    // Without contact forces the excitation's work per period is what the modal damping
+    // dissipates (the massless residual flexibility does no work): an independent check of
+    // the excitation's displacement energy() takes from Q_1's excitation row.
+    std::vector<Eigen::VectorXcd> no_forces(3, Eigen::VectorXcd::Zero(c));
+    double work = 0.0, viscous = 0.0;
+    part.energy(w, no_forces, work, viscous);
+    ASSERT_GT(viscous, 0.0);
+    EXPECT_NEAR(work, viscous, kRoundOff * viscous) << "residual " << residual;
+  }
+}
+
+TEST(ManyPairsSector, ReceptancesBuiltOnTwoThreadsAreBitwiseThoseOfOne) {
+  // The harmonic indices' flexibilities are computed in parallel, each by the same operations.
+  const frf::SectorLinearPart one = sector().linear(true, 1), two = sector().linear(true, 2);
+  const double w = 0.9 * sector().bases.at(1).omega[0];
+  for (int n : {0, 1, 2}) {
+    frf::HarmonicReceptance a, b;
+    one.harmonic(n, w, a);
+    two.harmonic(n, w, b);
+    EXPECT_TRUE(a.G == b.G) << "n " << n;
+    EXPECT_TRUE(a.H == b.H) << "n " << n;
+    EXPECT_TRUE(a.w_lin == b.w_lin) << "n " << n;
+  }
+}
+
+/// The sector's linear part without its factored form: the harmonic balance then forms every
+/// G_n densely, as it does for lumped models.
+class DenseOnly : public frf::LinearPart {
+ public:
+  explicit DenseOnly(const frf::LinearPart& part) : part_(part) {}
+  int n_contact() const override { return part_.n_contact(); }
+  int n_response() const override { return part_.n_response(); }
+  void harmonic(int n, double w, frf::HarmonicReceptance& out) const override { part_.harmonic(n, w, out); }
+  void harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG, Eigen::VectorXcd& dw_lin) const override {
+    part_.harmonic_derivative(n, w, dG, dw_lin);
+  }
+  void energy(double w, const std::vector<Eigen::VectorXcd>& forces, double& work, double& viscous) const override {
+    part_.energy(w, forces, work, viscous);
+  }
+  std::string describe() const override { return part_.describe(); }
+
+ private:
+  const frf::LinearPart& part_;
+};
+
+TEST(ManyPairsSector, ResidualWithTheFactoredReceptancesEqualsTheDenseOne) {
+  const frf::SectorLinearPart part = sector().linear(true);
+  const DenseOnly dense_part(part);
+  // preload_in_equilibrium: the static term G_0 F_s too.
+  hbm::ContactEvaluator ev(evaluator_options(2), sector_pairs(/*preload_in_equilibrium=*/true));
+  ReducedEquations factored(part, ev), plain(dense_part, ev);
+  const Eigen::VectorXd w = mixed_state(ev, 5, 2e-6);
+  for (double f : {0.8, 1.1}) {
+    const double hz = f * sector().bases.at(1).omega[0] / (2 * kPi);
+    Eigen::VectorXd r1, r2, d1, d2;
+    Eigen::MatrixXd j1, j2;
+    ASSERT_TRUE(factored.evaluate(w, hz, r1, &j1, &d1));
+    ASSERT_TRUE(plain.evaluate(w, hz, r2, &j2, &d2));
+    EXPECT_LE((r1 - r2).norm(), kRoundOff * r2.norm());
+    EXPECT_LE((d1 - d2).norm(), kRoundOff * d2.norm());
+    EXPECT_LE((j1 - j2).norm(), kRoundOff * j2.norm());
+  }
+}
+
 TEST(ManyPairsSector, AllShroudPairsBorderedKrylovAndDenseSolvesAgree) {
   const frf::SectorLinearPart part = sector().linear(true);
-  std::vector<contact::PairParameters> pairs(sector().mesh.shroud_pairs.size());
-  for (auto& p : pairs) {
-    p.tangential_stiffness = 2e5;
-    p.normal_stiffness = 2e5;
-    p.friction_coefficient = 0.3;
-    p.normal_preload = 0.05;
-  }
-  hbm::ContactEvaluator ev(evaluator_options(2), pairs);
+  hbm::ContactEvaluator ev(evaluator_options(2), sector_pairs(false));
   ReducedEquations eq(part, ev);
   ASSERT_GE(ev.n_pairs(), 5);
   const int n = eq.size();
