@@ -67,7 +67,8 @@ class SectorLinearPart : public LinearPart {
   /// (residual) flexibility blocks: after construction each harmonic costs O(k^2 modes).
   /// threads (0: all cores): the pairs of conjugate indices {h, Nb - h} are computed in
   /// parallel, each with one factor: factor must then be safe to call from several threads
-  /// (it is called once per pair, for h <= Nb / 2 or for index 0).
+  /// (it is called once per pair, for the first of its indices the model has, and once for
+  /// index 0).
   SectorLinearPart(const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
                    const std::function<modal::StiffnessFactor(int)>& factor, std::vector<SectorContactPair> pairs,
                    SectorForcing forcing, int n_harmonics, int threads = 1);
