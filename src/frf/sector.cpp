@@ -13,6 +13,11 @@
 
 namespace shroudsim::frf {
 namespace {
+/// A mode's receptance denominator w_r^2 - W^2 + 2 i z w_r W at circular frequency W.
+std::complex<double> modal_denominator(double omega_r, double big_w, double z) {
+  return std::complex<double>(omega_r * omega_r - big_w * big_w, 2.0 * z * omega_r * big_w);
+}
+
 /// A <- (A + A^H) / 2: exactly Hermitian (C K^-1 C^H is, but its computed form only to
 /// round-off), so that a product may read one triangle (FactoredReceptance).
 void make_hermitian(Eigen::MatrixXcd& a) {
@@ -186,8 +191,7 @@ Eigen::MatrixXcd SectorLinearPart::receptance(int n, double w) const {
   const IndexData& d = dynamic_.at(harmonic_index(n));
   const double big_w = n * w, z = forcing_.damping_ratio;
   Eigen::VectorXcd inv(d.omega.size());
-  for (Eigen::Index r = 0; r < d.omega.size(); ++r)
-    inv[r] = 1.0 / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+  for (Eigen::Index r = 0; r < d.omega.size(); ++r) inv[r] = 1.0 / modal_denominator(d.omega[r], big_w, z);
   return d.psi * inv.asDiagonal() * d.psi.adjoint() + d.flex;
 }
 
@@ -216,7 +220,7 @@ void SectorLinearPart::harmonic_derivative(int n, double w, Eigen::MatrixXcd& dG
   const double big_w = n * w, z = forcing_.damping_ratio;
   Eigen::VectorXcd dinv(d.omega.size());
   for (Eigen::Index r = 0; r < d.omega.size(); ++r) {
-    const Complex den(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+    const Complex den = modal_denominator(d.omega[r], big_w, z);
     dinv[r] = static_cast<double>(n) * Complex(2.0 * big_w, -2.0 * z * d.omega[r]) / (den * den);
   }
   const auto psi_c = d.psi.topRows(c);
@@ -235,8 +239,7 @@ void SectorLinearPart::response_harmonic(int n, double w, Eigen::MatrixXcd& H, E
   const IndexData& d = dynamic_.at(harmonic_index(n));
   const double big_w = n * w, z = forcing_.damping_ratio;
   Eigen::VectorXcd inv(d.omega.size());
-  for (Eigen::Index r = 0; r < d.omega.size(); ++r)
-    inv[r] = 1.0 / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+  for (Eigen::Index r = 0; r < d.omega.size(); ++r) inv[r] = 1.0 / modal_denominator(d.omega[r], big_w, z);
   // Rows c..c+2 of Q_n = Psi diag(inv) Psi^H + flex: columns 0..c-1 (H) and c+3 (u_lin).
   const Eigen::MatrixXcd rows = d.psi.middleRows(c, 3) * inv.asDiagonal();
   H = rows * d.psi.topRows(c).adjoint() + d.flex.block(c, 0, 3, c);
@@ -263,7 +266,7 @@ bool SectorLinearPart::factored_harmonic(int n, double w, bool derivative, Facto
   out.s.resize(modes);
   if (derivative) out.ds.resize(modes);
   for (Eigen::Index r = 0; r < modes; ++r) {
-    const Complex den(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+    const Complex den = modal_denominator(d.omega[r], big_w, z);
     out.s[r] = 1.0 / den;
     // As harmonic_derivative: d/dw of 1/den at W = n w.
     if (derivative) out.ds[r] = static_cast<double>(n) * Complex(2.0 * big_w, -2.0 * z * d.omega[r]) / (den * den);
@@ -293,7 +296,7 @@ void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& for
     const double big_w = static_cast<double>(n) * w, z = forcing_.damping_ratio;
     const Eigen::VectorXcd p = d.psi.adjoint() * g;  // modal loads
     for (Eigen::Index r = 0; r < d.omega.size(); ++r) {
-      const Complex q = p[r] / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+      const Complex q = p[r] / modal_denominator(d.omega[r], big_w, z);
       // Modal viscous force 2 z w_r q'; per fundamental period pi n^2 w c_r |q|^2.
       viscous_dissipation += kPi * static_cast<double>(n * n) * w * 2.0 * z * d.omega[r] * std::norm(q);
     }
@@ -302,7 +305,7 @@ void SectorLinearPart::energy(double w, const std::vector<Eigen::VectorXcd>& for
       // psi_e diag(1 / den) Psi^H g + flex_e g (the modal loads p = Psi^H g from above).
       Complex u_e = (d.flex.row(c + 3) * g).value();
       for (Eigen::Index r = 0; r < d.omega.size(); ++r)
-        u_e += d.psi(c + 3, r) * p[r] / Complex(d.omega[r] * d.omega[r] - big_w * big_w, 2.0 * z * d.omega[r] * big_w);
+        u_e += d.psi(c + 3, r) * p[r] / modal_denominator(d.omega[r], big_w, z);
       excitation_work += kPi * (-u_e.imag());  // pi Im(1 * conj(U_e))
     }
   }
