@@ -82,13 +82,17 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
   // would be n x k complex, 2.6 GB on a 238k-DOF sector with 227 pairs (and CHOLMOD copies
   // it twice more), where a block of 64 columns is 0.24 GB.
   constexpr Eigen::Index kFlexibilityBlock = 64;
-  auto static_flexibility = [&](const modal::StiffnessFactor& k, const Eigen::SparseMatrix<Complex>& ct) {
+  // keep (not null): K_h^-1 C_h^H itself, the solutions the shapes reuse (static_solution()).
+  auto static_flexibility = [&](const modal::StiffnessFactor& k, const Eigen::SparseMatrix<Complex>& ct,
+                                Eigen::MatrixXcd* keep) {
     const Eigen::SparseMatrix<Complex> cth = ct.adjoint();
     Eigen::MatrixXcd flex(ct.rows(), ct.rows());
+    if (keep) keep->resize(cth.rows(), cth.cols());
     for (Eigen::Index j0 = 0; j0 < cth.cols(); j0 += kFlexibilityBlock) {
       const Eigen::Index nb = std::min(kFlexibilityBlock, cth.cols() - j0);
       const Eigen::MatrixXcd y = k.solve(Eigen::MatrixXcd(cth.middleCols(j0, nb)));
       flex.middleCols(j0, nb).noalias() = ct * y;
+      if (keep) keep->middleCols(j0, nb) = y;
     }
     return flex;
   };
@@ -121,14 +125,23 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
                    [&](const auto& a, const auto& b) { return !is_real_index(a.first) && is_real_index(b.first); });
   std::vector<std::vector<IndexData>> results(jobs.size());
   std::vector<IndexTimes> times(jobs.size());
+  // The static solutions are kept when all of them fit in kKeptSolutionBytes: one per group
+  // that factors (index 0, and with residual flexibility the first index of each group).
+  std::size_t solved = 0;
+  for (const auto& job : jobs) solved += job.first == 0 || forcing_.residual_flexibility ? 1 : 0;
+  const double kept_bytes = static_cast<double>(solved) * static_cast<double>(sector.n_reduced()) *
+                            static_cast<double>(n_contact() + 4) * static_cast<double>(sizeof(Complex));
+  const bool keep_solutions = kept_bytes <= static_cast<double>(kKeptSolutionBytes);
+  std::vector<std::pair<int, Eigen::MatrixXcd>> kept(jobs.size(), {-1, Eigen::MatrixXcd()});
   IndexData static_data;
-  auto index_data = [&](int h, const Eigen::SparseMatrix<Complex>& ct, const modal::StiffnessFactor* k) {
+  // full: the static flexibility C_h K_h^-1 C_h^H (null: no residual flexibility).
+  auto index_data = [&](int h, const Eigen::SparseMatrix<Complex>& ct, const Eigen::MatrixXcd* full) {
     const modal::ModalBasis& b = bases.at(h);
     IndexData d;
     d.omega = b.omega;
     d.psi = ct * b.phi;
-    if (k) {
-      d.flex = static_flexibility(*k, ct);
+    if (full) {
+      d.flex = *full;
       for (Eigen::Index r = 0; r < d.omega.size(); ++r)
         d.flex -= d.psi.col(r) * d.psi.col(r).adjoint() / (d.omega[r] * d.omega[r]);
       make_hermitian(d.flex);
@@ -137,53 +150,70 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
     }
     return d;
   };
-  linalg::parallel_for(static_cast<int>(jobs.size()), linalg::worker_count(threads, static_cast<int>(jobs.size())),
-                       [&](int j) {
-                         const auto& [canonical, members] = jobs[static_cast<std::size_t>(j)];
-                         // The factor of the group's first index (index 0 for the static group).
-                         const int first = canonical == 0 ? 0 : members.front();
-                         const bool need_factor = canonical == 0 || forcing_.residual_flexibility;
-                         log::Stopwatch clock;
-                         const modal::StiffnessFactor k_first = need_factor ? factor(first) : modal::StiffnessFactor();
-                         IndexTimes& t = times[static_cast<std::size_t>(j)];
-                         t.indices = members;
-                         if (canonical == 0 && (members.empty() || members.front() != 0))
-                           t.indices.insert(t.indices.begin(), 0);
-                         t.factor_seconds = clock.seconds();
-                         clock.restart();
-                         std::vector<IndexData>& out = results[static_cast<std::size_t>(j)];
-                         for (int h : members) {
-                           if (h != members.front()) {  // Nb - h: the data of h conjugated
-                             IndexData d;
-                             d.omega = out.front().omega;
-                             d.psi = out.front().psi.conjugate();
-                             d.flex = out.front().flex.conjugate();
-                             out.push_back(std::move(d));
-                             continue;
-                           }
-                           const Eigen::SparseMatrix<Complex> ct = projected(h);
-                           out.push_back(index_data(h, ct, forcing_.residual_flexibility ? &k_first : nullptr));
-                         }
-                         if (canonical == 0) {
-                           const Eigen::SparseMatrix<Complex> ct = projected(0);
-                           static_data.flex = static_flexibility(k_first, ct);
-                           make_hermitian(static_data.flex);
-                           // With the modes of index 0 at hand, harmonic 0's second-order form
-                           // is dynamic (the Floquet analysis: a perturbation's mean oscillates
-                           // at lambda, not at 0).
-                           if (auto it = bases.find(0); it != bases.end()) {
-                             static_data.omega = it->second.omega;
-                             static_data.psi = ct * it->second.phi;
-                           }
-                         }
-                         t.flexibility_seconds = clock.seconds();
-                       });
+  linalg::parallel_for(
+      static_cast<int>(jobs.size()), linalg::worker_count(threads, static_cast<int>(jobs.size())), [&](int j) {
+        const auto& [canonical, members] = jobs[static_cast<std::size_t>(j)];
+        // The factor of the group's first index (index 0 for the static group).
+        const int first = canonical == 0 ? 0 : members.front();
+        const bool need_factor = canonical == 0 || forcing_.residual_flexibility;
+        log::Stopwatch clock;
+        const modal::StiffnessFactor k_first = need_factor ? factor(first) : modal::StiffnessFactor();
+        IndexTimes& t = times[static_cast<std::size_t>(j)];
+        t.indices = members;
+        if (canonical == 0 && (members.empty() || members.front() != 0)) t.indices.insert(t.indices.begin(), 0);
+        t.factor_seconds = clock.seconds();
+        clock.restart();
+        std::vector<IndexData>& out = results[static_cast<std::size_t>(j)];
+        auto& [solved_index, solution] = kept[static_cast<std::size_t>(j)];
+        Eigen::MatrixXcd* keep = keep_solutions && need_factor ? &solution : nullptr;
+        if (keep) solved_index = first;
+        // Index 0's static flexibility, when index 0 is also dynamic: one solve
+        // for both.
+        std::optional<Eigen::MatrixXcd> flex_of_first;
+        for (int h : members) {
+          if (h != members.front()) {  // Nb - h: the data of h conjugated
+            IndexData d;
+            d.omega = out.front().omega;
+            d.psi = out.front().psi.conjugate();
+            d.flex = out.front().flex.conjugate();
+            out.push_back(std::move(d));
+            continue;
+          }
+          const Eigen::SparseMatrix<Complex> ct = projected(h);
+          if (forcing_.residual_flexibility) flex_of_first = static_flexibility(k_first, ct, keep);
+          out.push_back(index_data(h, ct, flex_of_first ? &*flex_of_first : nullptr));
+        }
+        if (canonical == 0) {
+          const Eigen::SparseMatrix<Complex> ct = projected(0);
+          static_data.flex = flex_of_first && first == members.front() ? std::move(*flex_of_first)
+                                                                       : static_flexibility(k_first, ct, keep);
+          make_hermitian(static_data.flex);
+          // With the modes of index 0 at hand, harmonic 0's second-order form
+          // is dynamic (the Floquet analysis: a perturbation's mean oscillates
+          // at lambda, not at 0).
+          if (auto it = bases.find(0); it != bases.end()) {
+            static_data.omega = it->second.omega;
+            static_data.psi = ct * it->second.phi;
+          }
+        }
+        t.flexibility_seconds = clock.seconds();
+      });
   std::sort(times.begin(), times.end(),
             [](const IndexTimes& a, const IndexTimes& b) { return a.indices.front() < b.indices.front(); });
   build_times_ = std::move(times);
   static_ = std::move(static_data);
   for (std::size_t j = 0; j < jobs.size(); ++j)
     for (std::size_t i = 0; i < jobs[j].second.size(); ++i) dynamic_[jobs[j].second[i]] = std::move(results[j][i]);
+  for (auto& [h, y] : kept)
+    if (h >= 0) solutions_[h] = std::move(y);
+}
+
+const Eigen::MatrixXcd* SectorLinearPart::static_solution(int h, bool& conjugated) const {
+  conjugated = false;
+  if (auto it = solutions_.find(h); it != solutions_.end()) return &it->second;
+  conjugated = true;
+  if (auto it = solutions_.find((sectors_ - h) % sectors_); it != solutions_.end()) return &it->second;
+  return nullptr;
 }
 
 Eigen::MatrixXcd SectorLinearPart::receptance(int n, double w) const {
@@ -398,56 +428,80 @@ std::string SectorLinearPart::describe() const {
 std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
     const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
     const std::function<modal::StiffnessFactor(int)>& factor, const std::vector<SectorContactPair>& pairs,
-    const SectorForcing& forcing, const std::vector<ShapeLoad>& loads) {
+    const SectorForcing& forcing, const std::vector<ShapeLoad>& loads, const SectorLinearPart* kept, int threads) {
   std::vector<std::vector<Eigen::VectorXcd>> out(loads.size());
   if (loads.empty()) return out;
   const int h_max = static_cast<int>(loads.front().forces.size()) - 1;
   const int nb = sector.sectors();
   const Eigen::Index c = 3 * static_cast<Eigen::Index>(pairs.size());
   for (auto& o : out) o.resize(h_max + 1);
-  // Harmonics n grouped by harmonic index h, so that each K_h is factored once.
+  // Harmonics n grouped by harmonic index h, and the indices by pairs {h, Nb - h} that share
+  // one K_h factor (index Nb - h's is h's conjugated).
   std::map<int, std::vector<int>> by_index;
   for (int n = 0; n <= h_max; ++n) by_index[harmonic_index(n, forcing.engine_order, nb)].push_back(n);
-  for (const auto& [h, harmonics] : by_index) {
-    const Eigen::SparseMatrix<Complex> rows = selection(pairs, forcing, sector, h, sector.n_full());
-    const Eigen::SparseMatrix<Complex> t = sector.expansion(h);
-    const Eigen::SparseMatrix<Complex> load_map = t.adjoint() * rows.adjoint();  // reduced x (c + 4)
-    const bool dynamic = harmonics.front() != 0 || harmonics.size() > 1;
-    const modal::ModalBasis* basis = nullptr;
-    if (dynamic) {
-      auto it = bases.find(h);
-      SHROUDSIM_CHECK(it != bases.end(), "modes of harmonic index " + std::to_string(h) + " given");
-      basis = &it->second;
-    }
-    const bool need_factor = harmonics.front() == 0 || forcing.residual_flexibility;
-    std::optional<modal::StiffnessFactor> k;
-    if (need_factor) k = factor(h);
-    for (std::size_t l = 0; l < loads.size(); ++l) {
-      for (int n : harmonics) {
-        SHROUDSIM_CHECK(loads[l].forces[n].size() == c, "contact forces of every pair");
-        Eigen::VectorXcd y = Eigen::VectorXcd::Zero(c + 4);
-        y.head(c) = -loads[l].forces[n];
-        if (n == 1 && loads[l].excitation) y(c + 3) = 1.0;
-        const Eigen::VectorXcd g = load_map * y;
-        Eigen::VectorXcd ur;
-        if (n == 0) {
-          ur = k->solve(Eigen::MatrixXcd(g)).col(0);
-        } else {
-          const double big_w = n * loads[l].w, z = forcing.damping_ratio;
-          const Eigen::VectorXcd modal = basis->phi.adjoint() * g;
-          Eigen::VectorXcd q(modal.size());
-          for (Eigen::Index r = 0; r < modal.size(); ++r) {
-            const double wr = basis->omega[r];
-            q[r] = modal[r] / Complex(wr * wr - big_w * big_w, big_w * (2.0 * z * wr - loads[l].zeta));
-            if (forcing.residual_flexibility) q[r] -= modal[r] / (wr * wr);
+  std::map<int, std::vector<int>> groups;
+  for (const auto& [h, harmonics] : by_index) groups[std::min(h, (nb - h) % nb)].push_back(h);
+  std::vector<std::vector<int>> jobs;
+  for (auto& [canonical, members] : groups) jobs.push_back(std::move(members));
+  linalg::parallel_for(
+      static_cast<int>(jobs.size()), linalg::worker_count(threads, static_cast<int>(jobs.size())), [&](int j) {
+        std::optional<modal::StiffnessFactor> first_factor;  // of jobs[j].front()
+        for (int h : jobs[static_cast<std::size_t>(j)]) {
+          const std::vector<int>& harmonics = by_index.at(h);
+          const Eigen::SparseMatrix<Complex> rows = selection(pairs, forcing, sector, h, sector.n_full());
+          const Eigen::SparseMatrix<Complex> t = sector.expansion(h);
+          const Eigen::SparseMatrix<Complex> load_map = t.adjoint() * rows.adjoint();  // n_red x (c + 4)
+          const bool dynamic = harmonics.front() != 0 || harmonics.size() > 1;
+          const modal::ModalBasis* basis = nullptr;
+          if (dynamic) {
+            auto it = bases.find(h);
+            SHROUDSIM_CHECK(it != bases.end(), "modes of harmonic index " + std::to_string(h) + " given");
+            basis = &it->second;
           }
-          ur = basis->phi * q;
-          if (forcing.residual_flexibility) ur += k->solve(Eigen::MatrixXcd(g)).col(0);
+          // x = K_h^-1 g for g = load_map y: from the kept solutions, or a factor.
+          bool conjugated = false;
+          const Eigen::MatrixXcd* solution = kept ? kept->static_solution(h, conjugated) : nullptr;
+          if (solution)
+            SHROUDSIM_CHECK(solution->rows() == load_map.rows() && solution->cols() == load_map.cols(),
+                            "static solutions of the same sector, pairs and forcing");
+          std::optional<modal::StiffnessFactor> k;
+          const bool need_factor = harmonics.front() == 0 || forcing.residual_flexibility;
+          if (need_factor && !solution) {
+            if (!first_factor) first_factor = factor(jobs[static_cast<std::size_t>(j)].front());
+            k = h == jobs[static_cast<std::size_t>(j)].front() ? *first_factor : first_factor->conjugate();
+          }
+          const auto static_solve = [&](const Eigen::VectorXcd& y) -> Eigen::VectorXcd {
+            if (!solution) return k->solve(Eigen::MatrixXcd(load_map * y)).col(0);
+            if (conjugated) return (*solution * y.conjugate()).conjugate();
+            return *solution * y;
+          };
+          for (std::size_t l = 0; l < loads.size(); ++l) {
+            for (int n : harmonics) {
+              SHROUDSIM_CHECK(loads[l].forces[n].size() == c, "contact forces of every pair");
+              Eigen::VectorXcd y = Eigen::VectorXcd::Zero(c + 4);
+              y.head(c) = -loads[l].forces[n];
+              if (n == 1 && loads[l].excitation) y(c + 3) = 1.0;
+              Eigen::VectorXcd ur;
+              if (n == 0) {
+                ur = static_solve(y);
+              } else {
+                const Eigen::VectorXcd g = load_map * y;
+                const double big_w = n * loads[l].w, z = forcing.damping_ratio;
+                const Eigen::VectorXcd modal = basis->phi.adjoint() * g;
+                Eigen::VectorXcd q(modal.size());
+                for (Eigen::Index r = 0; r < modal.size(); ++r) {
+                  const double wr = basis->omega[r];
+                  q[r] = modal[r] / Complex(wr * wr - big_w * big_w, big_w * (2.0 * z * wr - loads[l].zeta));
+                  if (forcing.residual_flexibility) q[r] -= modal[r] / (wr * wr);
+                }
+                ur = basis->phi * q;
+                if (forcing.residual_flexibility) ur += static_solve(y);
+              }
+              out[l][n] = t * ur;
+            }
+          }
         }
-        out[l][n] = t * ur;
-      }
-    }
-  }
+      });
   return out;
 }
 

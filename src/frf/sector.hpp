@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <complex>
+#include <cstddef>
 #include <functional>
 #include <map>
 #include <vector>
@@ -59,6 +60,14 @@ int harmonic_index(int n, int engine_order, int sectors);
 /// L_i(a, :) (u_q - exp(i h alpha) R u_p), summed with weights over a patch.
 Eigen::SparseMatrix<std::complex<double>> contact_rows(const std::vector<SectorContactPair>& pairs,
                                                        const cyclic::CyclicSector& sector, int h, Eigen::Index n_full);
+
+/// The largest memory SectorLinearPart keeps for its static solutions K_h^-1 C_h^H (see
+/// static_solution()), n_reduced (3 pairs + 4) complex numbers per factored index: 1 GiB holds
+/// them for 5 pairs up to ~700k reduced DOFs and for 139 pairs up to ~32k (5 factored indices).
+/// On the 77k-DOF sector with 5 pairs they take 117 MB, and the run's peak resident memory fell
+/// (3.73 to 3.68 GB) as the shapes no longer factor K_h again. Beyond the budget the shapes
+/// factor again (sector_displacements) rather than the continuation hold gigabytes.
+constexpr std::size_t kKeptSolutionBytes = std::size_t{1} << 30;
 
 class SectorLinearPart : public LinearPart {
  public:
@@ -117,6 +126,13 @@ class SectorLinearPart : public LinearPart {
   };
   const std::vector<IndexTimes>& build_times() const { return build_times_; }
 
+  /// K_h^-1 C_h^H (n_reduced x (k + 4), C_h T_h as in the receptances: contact, response and
+  /// excitation rows) of harmonic index h, kept from the construction's solves when all of them
+  /// fit in kKeptSolutionBytes: the operating deflection shapes (sector_displacements) then
+  /// need no new factorization. conjugated: the matrix returned is that of Nb - h (index h's
+  /// is its complex conjugate). nullptr: not kept.
+  const Eigen::MatrixXcd* static_solution(int h, bool& conjugated) const;
+
  private:
   struct IndexData {
     Eigen::VectorXd omega;  ///< modes kept [rad/s]
@@ -137,6 +153,7 @@ class SectorLinearPart : public LinearPart {
   std::map<int, IndexData> dynamic_;  ///< per harmonic index of n >= 1
   IndexData static_;                  ///< n = 0 (h = 0): exact static flexibility in flex
   std::vector<IndexTimes> build_times_;
+  std::map<int, Eigen::MatrixXcd> solutions_;  ///< static_solution(), by the index solved
 };
 
 /// The loads of one operating deflection shape: fundamental circular frequency w [rad/s] and
@@ -158,10 +175,15 @@ struct ShapeLoad {
 /// with damping and, with forcing.residual_flexibility, the residual flexibility
 /// K_h^-1 - sum_r phi_r phi_r^H / w_r^2; n = 0: the static flexibility K_0^-1 (docs/physics.md
 /// section 3). The response and contact rows of U_n are the harmonic balance's response and
-/// relative displacements. One K_h factorization per harmonic index for all loads.
+/// relative displacements. K_h^-1 is applied through `kept`'s static solutions where it has
+/// them (SectorLinearPart::static_solution(), built from the same sector, pairs and forcing),
+/// else through one factorization per pair of conjugate indices {h, Nb - h} for all loads,
+/// the pairs in parallel on `threads` workers (0: all cores; factor must then be safe to call
+/// from several threads). The result does not depend on the thread count.
 std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
     const cyclic::CyclicSector& sector, const std::map<int, modal::ModalBasis>& bases,
     const std::function<modal::StiffnessFactor(int)>& factor, const std::vector<SectorContactPair>& pairs,
-    const SectorForcing& forcing, const std::vector<ShapeLoad>& loads);
+    const SectorForcing& forcing, const std::vector<ShapeLoad>& loads, const SectorLinearPart* kept = nullptr,
+    int threads = 1);
 
 }  // namespace shroudsim::frf

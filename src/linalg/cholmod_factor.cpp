@@ -3,6 +3,7 @@
 #include <Eigen/CholmodSupport>
 
 #include <algorithm>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -65,6 +66,19 @@ struct CholmodFactor<Scalar>::Impl {
   }
 };
 
+namespace {
+// CHOLMOD's nested-dissection ordering (METIS, tried when AMD's fill is poor: the larger
+// sectors) draws from a random generator that is global to the process and reseeded at each
+// call. Two analyses at once on different threads (the parallel stages) interleave their
+// draws, so the ordering, and the factor's round-off, depended on the timing: the 77k-DOF
+// sector gave a linear amplitude that differed by 2e-9 between two identical runs on two
+// threads. One analysis at a time.
+std::mutex& analysis_lock() {
+  static std::mutex lock;
+  return lock;
+}
+}  // namespace
+
 template <typename Scalar>
 CholmodFactor<Scalar>::CholmodFactor(FactorMethod method) : impl_(std::make_unique<Impl>()) {
   impl_->llt.setMode(method == FactorMethod::Supernodal ? Eigen::CholmodSupernodalLLt : Eigen::CholmodSimplicialLLt);
@@ -85,6 +99,7 @@ void CholmodFactor<Scalar>::analyze(const SparseMatrix<Scalar>& A) {
   SHROUDSIM_CHECK(A.rows() == A.cols(), "CholmodFactor: matrix must be square");
   SHROUDSIM_CHECK(A.isCompressed(), "CholmodFactor: matrix must be compressed");
   rows_ = A.rows();
+  const std::lock_guard<std::mutex> one_at_a_time(analysis_lock());
   impl_->llt.analyzePattern(A);
   status_ = impl_->llt.info() == Eigen::Success ? FactorStatus::Success : FactorStatus::Failed;
 }

@@ -5,6 +5,7 @@
 // files atomically (io/output.hpp), print one progress line per stage (log::info), and
 // record timings in the report. The commands of src/app are drivers over these.
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -12,6 +13,8 @@
 #include "mesh/mesh.hpp"
 
 namespace shroudsim::pipeline {
+
+struct ModalModel;
 
 /// Collects what run.json reports: stage timings, what was reused, statistics, warnings.
 class RunReport {
@@ -39,6 +42,10 @@ struct Context {
   bool resume = false;                 ///< `study --resume`: reuse the finished points in out_dir
   /// (frequency [Hz], amplitude [m]) of the forced response cmd_frf traced (as in frf.csv).
   std::vector<std::pair<double, double>> frf_curve;
+  /// The modal model (mesh, K and M, the modes; no factors) that make_sector_model built the
+  /// forced response on, kept for its shapes (sector_shapes), which would otherwise read the
+  /// mesh, assemble and load the modes again.
+  std::shared_ptr<ModalModel> forced_modal;
   RunReport report;
 };
 

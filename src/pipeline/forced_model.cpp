@@ -123,8 +123,9 @@ ForcedModel make_sector_model(Context& ctx) {
   // modal solve) differs from it in round-off, so a run with the modes cached and one that solves them would
   // give different curves where the continuation's path is sensitive to round-off (the
   // default case: 649 points in two pieces against 343 in one, the same located peak).
-  ModalModel modal = run_modal_stage(ctx, needed, /*keep_factors=*/false,
-                                     c.excitation.speed_rpm);  // > 0: the modes at that speed
+  auto kept_modal = std::make_shared<ModalModel>(run_modal_stage(ctx, needed, /*keep_factors=*/false,
+                                                                 c.excitation.speed_rpm));  // > 0: at that speed
+  ModalModel& modal = *kept_modal;
   if (!modal.failures.empty()) throw NumericalError("modal stage failed: " + modal.failures.front());
   const mesh::Mesh& mesh = modal.mesh;
 
@@ -161,8 +162,9 @@ ForcedModel make_sector_model(Context& ctx) {
   forcing.residual_flexibility = c.modal.residual_flexibility;
   log::Stopwatch clock;
   const cyclic::CyclicSector& sector = modal.cyclic();
-  // The K_h factors are computed in parallel (one per pair of conjugate indices): the map of
-  // factors the model keeps for the shapes is filled under a lock, each factorization outside it.
+  // The K_h factors are computed in parallel (one per pair of conjugate indices), each outside
+  // the lock that guards the map they are stored in; they are dropped once the receptances are
+  // built (the shapes take the static solutions the linear part keeps, or factor again).
   std::mutex factors_lock;
   const auto factor = [&](int h) {
     {
@@ -175,6 +177,7 @@ ForcedModel make_sector_model(Context& ctx) {
   };
   model.linear = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, factor, pairs, forcing, c.hbm.harmonics,
                                                          ctx.threads);
+  modal.factors.clear();
   model.sector_pairs = pairs;
   model.sector_forcing = forcing;
   ctx.report.stage("receptances", clock.seconds());
@@ -211,6 +214,7 @@ ForcedModel make_sector_model(Context& ctx) {
     << " shroud node pairs, contact area " << total * 1e6 << " mm^2; excitation node " << forcing.excitation_node
     << ", response node " << forcing.response_node;
   log::info(s.str());
+  ctx.forced_modal = std::move(kept_modal);
   return model;
 }
 

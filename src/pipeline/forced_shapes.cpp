@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 #include <filesystem>
+#include <mutex>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -14,6 +15,7 @@
 #include "frf/sector.hpp"
 #include "io/output.hpp"
 #include "io/vtu.hpp"
+#include "modal/harmonic.hpp"
 #include "pipeline/forced_model.hpp"
 #include "pipeline/modal_stage.hpp"
 
@@ -93,6 +95,7 @@ void write_sector_files(Context& ctx, const forced::ForcedModel& model, const st
   for (std::size_t s = 0; s < shapes.size(); ++s)
     loads.push_back({2.0 * std::numbers::pi * shapes[s].frequency_hz, forces[s]});
   const SectorShapes shaped = sector_shapes(ctx, model, loads, "shapes");
+  log::Stopwatch clock;
   const mesh::Mesh& mesh = shaped.mesh;
   const Eigen::Index nodes = mesh.nodes.rows();
   std::vector<io::PointField> fields;
@@ -131,6 +134,7 @@ void write_sector_files(Context& ctx, const forced::ForcedModel& model, const st
     add("normal_load_max_n", &forced::PairState::normal_load_max_n);
   }
   io::write_point_fields_vtu(ctx.out_dir / "contact.vtu", mesh, contact);
+  if (log::detailed()) log::info("shapes: files written in " + io::format_number(clock.seconds()) + " s");
 }
 
 }  // namespace
@@ -138,19 +142,40 @@ void write_sector_files(Context& ctx, const forced::ForcedModel& model, const st
 SectorShapes sector_shapes(const Context& ctx, const forced::ForcedModel& model,
                            const std::vector<frf::ShapeLoad>& loads, const std::string& what) {
   const io::Case& c = ctx.config;
-  // The modes again, from the stage cache (a run of its own, so that run.json keeps the forced
-  // model's modal section): the forced model does not hold the mode shapes.
-  Context modal_ctx;
-  modal_ctx.config = c;
-  modal_ctx.out_dir = ctx.out_dir;
-  modal_ctx.threads = ctx.threads;
-  ModalModel modal = run_modal_stage(modal_ctx, forced_harmonic_indices(c), false, c.excitation.speed_rpm);
+  log::Stopwatch clock;
+  // The modal model the forced response was built on, kept in the context; else (a model
+  // built elsewhere) the modes again from the stage cache, in a run of its own so that
+  // run.json keeps the forced model's modal section.
+  std::shared_ptr<ModalModel> kept = ctx.forced_modal;
+  if (!kept) {
+    Context modal_ctx;
+    modal_ctx.config = c;
+    modal_ctx.out_dir = ctx.out_dir;
+    modal_ctx.threads = ctx.threads;
+    kept = std::make_shared<ModalModel>(
+        run_modal_stage(modal_ctx, forced_harmonic_indices(c), false, c.excitation.speed_rpm));
+  }
+  ModalModel& modal = *kept;
   if (!modal.failures.empty()) throw NumericalError(what + ": modal stage failed: " + modal.failures.front());
+  const double modal_seconds = clock.seconds();
+  clock.restart();
   SectorShapes out;
-  out.u = frf::sector_displacements(
-      modal.cyclic(), modal.bases, [&](int h) { return modal.stiffness_factor(h); }, model.sector_pairs,
-      *model.sector_forcing, loads);
+  // K_h^-1 from the receptance stage's solutions where the model kept them, else factors
+  // computed in parallel (one per pair of conjugate indices), each outside the lock.
+  const cyclic::CyclicSector& sector = modal.cyclic();
+  std::mutex factors_lock;
+  const auto factor = [&](int h) {
+    const modal::StiffnessFactor k = modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method);
+    const std::lock_guard<std::mutex> g(factors_lock);
+    return modal.factors.emplace(h, k).first->second;
+  };
+  out.u = frf::sector_displacements(sector, modal.bases, factor, model.sector_pairs, *model.sector_forcing, loads,
+                                    dynamic_cast<const frf::SectorLinearPart*>(model.linear.get()), ctx.threads);
   out.mesh = modal.mesh;
+  modal.factors.clear();
+  if (log::detailed())
+    log::info(what + ": modal stage " + io::format_number(modal_seconds) + " s, displacements " +
+              io::format_number(clock.seconds()) + " s");
   return out;
 }
 

@@ -4,8 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseLU>
+#include <algorithm>
+#include <mutex>
 #include <numbers>
 #include <random>
+#include <set>
 
 #include "../common/coarse_sector.hpp"
 #include "cyclic/cyclic_sector.hpp"
@@ -382,6 +385,82 @@ TEST(SectorReceptance, ConjugatedBasisAndFactorServeHarmonicIndexNbMinusH) {
   const int c = part.n_contact();
   EXPECT_LT((rec.G - q.topLeftCorner(c, c)).norm(), 1e-3 * q.topLeftCorner(c, c).norm());
   EXPECT_LT((rec.w_lin - q.block(0, c + 3, c, 1)).norm(), 1e-3 * q.block(0, c + 3, c, 1).norm());
+}
+
+// The shapes reuse the receptances' static solutions K_h^-1 C_h^H (SectorLinearPart keeps
+// them when they fit in kKeptSolutionBytes): the displacements through them equal those
+// through a new factorization to round-off, for the static harmonic, the dynamic ones, and a
+// harmonic whose index is the conjugate of the one solved; and without kept solutions the
+// factorizations, one per pair of conjugate indices in parallel, give the same field on one
+// thread and on two.
+TEST(SectorShapes, KeptStaticSolutionsGiveTheFactorsDisplacements) {
+  const Fixture f;
+  const int nb = f.sector->sectors();
+  std::vector<SectorContactPair> pairs = some_pairs(f, 3, 2, 0.3, 0.2, Eigen::Vector3d(1, 2, 3));
+  SectorForcing forcing;
+  forcing.engine_order = 2;
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  forcing.damping_ratio = 0.01;
+  modal::ModalOptions mo;
+  mo.modes = 12;
+  // Harmonics n = 0..H with engine order 2: indices 2 n mod Nb, so that some harmonic falls
+  // on the conjugate Nb - h of another's index.
+  const int n_harmonics = nb - 1;
+  std::map<int, modal::ModalBasis> bases;
+  for (int n = 0; n <= n_harmonics; ++n) {
+    const int h = (2 * n) % nb;
+    if (bases.count(h)) continue;
+    auto r = modal::solve_harmonic(*f.sector, h, mo);
+    ASSERT_TRUE(r.report.ok()) << r.report.message;
+    bases[h] = r.basis;
+  }
+  int factorizations = 0;
+  std::mutex lock;
+  auto factor = [&](int h) {
+    {
+      const std::lock_guard<std::mutex> g(lock);
+      ++factorizations;
+    }
+    return modal::factor_harmonic_stiffness(*f.sector, h);
+  };
+  const int c = 9;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g;
+  std::vector<Eigen::VectorXcd> forces(n_harmonics + 1, Eigen::VectorXcd(c));
+  for (auto& fn : forces)
+    for (int i = 0; i < c; ++i) fn[i] = Complex(g(rng), g(rng));
+  forces[0] = forces[0].real().cast<Complex>();
+  const double w = 0.7 * bases.at(2).omega[0];
+  forcing.residual_flexibility = true;
+  const SectorLinearPart part(*f.sector, bases, factor, pairs, forcing, n_harmonics, 2);
+  bool conjugated = true;
+  ASSERT_NE(part.static_solution(0, conjugated), nullptr);
+  EXPECT_FALSE(conjugated);
+  bool has_conjugate = false;  // a harmonic index whose solution is its conjugate's
+  for (int n = 1; n <= n_harmonics; ++n) {
+    ASSERT_NE(part.static_solution(part.harmonic_index(n), conjugated), nullptr) << "n " << n;
+    has_conjugate = has_conjugate || conjugated;
+  }
+  ASSERT_TRUE(has_conjugate);
+
+  factorizations = 0;
+  const auto kept = sector_displacements(*f.sector, bases, factor, pairs, forcing, {{w, forces}}, &part, 2);
+  EXPECT_EQ(factorizations, 0);
+  factorizations = 0;
+  const auto one = sector_displacements(*f.sector, bases, factor, pairs, forcing, {{w, forces}}, nullptr, 1);
+  std::set<int> groups;  // one factorization per pair of conjugate indices {h, Nb - h}
+  for (int n = 0; n <= n_harmonics; ++n) groups.insert(std::min((2 * n) % nb, (nb - (2 * n) % nb) % nb));
+  EXPECT_EQ(factorizations, static_cast<int>(groups.size()));
+  const auto two = sector_displacements(*f.sector, bases, factor, pairs, forcing, {{w, forces}}, nullptr, 2);
+  // K_h^-1 (C^H y) against (K_h^-1 C^H) y: two orders of the same solves, held to the
+  // round-off bound of the test above.
+  constexpr double kRoundOff = 1e-9;
+  for (int n = 0; n <= n_harmonics; ++n) {
+    EXPECT_LT((kept[0][n] - one[0][n]).norm(), kRoundOff * one[0][n].norm()) << "n " << n;
+    EXPECT_TRUE(one[0][n] == two[0][n]) << "n " << n;  // bitwise: each index's arithmetic on any thread count
+  }
 }
 
 }  // namespace
