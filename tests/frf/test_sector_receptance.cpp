@@ -128,6 +128,27 @@ TEST(SectorReceptance, ModalSumWithResidualFlexibilityMatchesTheDirectSolve) {
   }
 }
 
+/// The shapes tests' forcing: excitation and response at two interior nodes.
+SectorForcing shape_forcing(const Fixture& f, int engine_order) {
+  SectorForcing forcing;
+  forcing.engine_order = engine_order;
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  return forcing;
+}
+
+/// Seeded random contact-force harmonics F_0..F_H (c each; F_0 real, as the static harmonic is).
+std::vector<Eigen::VectorXcd> random_forces(int n_harmonics, int c, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<Eigen::VectorXcd> forces(static_cast<std::size_t>(n_harmonics) + 1, Eigen::VectorXcd(c));
+  for (auto& fn : forces)
+    for (int i = 0; i < c; ++i) fn[i] = Complex(g(rng), g(rng));
+  forces[0] = forces[0].real().cast<Complex>();
+  return forces;
+}
+
 // The whole-sector displacement of the shapes (frf.vtu): its contact and response rows are the
 // receptance's (w_lin - G F, u_lin - H F) to round-off, for the static and dynamic harmonics
 // with and without residual flexibility; and below the first mode the whole field agrees with
@@ -135,11 +156,7 @@ TEST(SectorReceptance, ModalSumWithResidualFlexibilityMatchesTheDirectSolve) {
 TEST(SectorShapes, WholeFieldHasTheReceptancesRowsAndMatchesTheDirectSolve) {
   const Fixture f;
   std::vector<SectorContactPair> pairs = some_pairs(f, 3, 2, 0.3, 0.2, Eigen::Vector3d(1, 2, 3));
-  SectorForcing forcing;
-  forcing.engine_order = 3;
-  forcing.excitation_node = f.mesh.n_nodes() / 2;
-  forcing.response_node = f.mesh.n_nodes() / 3;
-  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  SectorForcing forcing = shape_forcing(f, 3);
   modal::ModalOptions mo;
   mo.modes = 20;
   std::map<int, modal::ModalBasis> bases;
@@ -152,12 +169,7 @@ TEST(SectorShapes, WholeFieldHasTheReceptancesRowsAndMatchesTheDirectSolve) {
   }
   auto factor = [&](int h) { return factors.at(h); };
   const int c = 9;
-  std::mt19937 rng(5);
-  std::normal_distribution<double> g;
-  std::vector<Eigen::VectorXcd> forces(3, Eigen::VectorXcd(c));
-  for (auto& fn : forces)
-    for (int i = 0; i < c; ++i) fn[i] = Complex(g(rng), g(rng));
-  forces[0] = forces[0].real().cast<Complex>();  // the static harmonic is real
+  const std::vector<Eigen::VectorXcd> forces = random_forces(2, c, 5);
   for (bool residual : {true, false}) {
     for (double zeta : {0.02, 0.0}) {
       forcing.residual_flexibility = residual;
@@ -397,11 +409,7 @@ TEST(SectorShapes, KeptStaticSolutionsGiveTheFactorsDisplacements) {
   const Fixture f;
   const int nb = f.sector->sectors();
   std::vector<SectorContactPair> pairs = some_pairs(f, 3, 2, 0.3, 0.2, Eigen::Vector3d(1, 2, 3));
-  SectorForcing forcing;
-  forcing.engine_order = 2;
-  forcing.excitation_node = f.mesh.n_nodes() / 2;
-  forcing.response_node = f.mesh.n_nodes() / 3;
-  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  SectorForcing forcing = shape_forcing(f, 2);
   forcing.damping_ratio = 0.01;
   modal::ModalOptions mo;
   mo.modes = 12;
@@ -426,12 +434,7 @@ TEST(SectorShapes, KeptStaticSolutionsGiveTheFactorsDisplacements) {
     return modal::factor_harmonic_stiffness(*f.sector, h);
   };
   const int c = 9;
-  std::mt19937 rng(11);
-  std::normal_distribution<double> g;
-  std::vector<Eigen::VectorXcd> forces(n_harmonics + 1, Eigen::VectorXcd(c));
-  for (auto& fn : forces)
-    for (int i = 0; i < c; ++i) fn[i] = Complex(g(rng), g(rng));
-  forces[0] = forces[0].real().cast<Complex>();
+  const std::vector<Eigen::VectorXcd> forces = random_forces(n_harmonics, c, 11);
   const double w = 0.7 * bases.at(2).omega[0];
   forcing.residual_flexibility = true;
   const SectorLinearPart part(*f.sector, bases, factor, pairs, forcing, n_harmonics, 2);
