@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -162,22 +161,12 @@ ForcedModel make_sector_model(Context& ctx) {
   forcing.residual_flexibility = c.modal.residual_flexibility;
   log::Stopwatch clock;
   const cyclic::CyclicSector& sector = modal.cyclic();
-  // The K_h factors are computed in parallel (one per pair of conjugate indices), each outside
-  // the lock that guards the map they are stored in; they are dropped once the receptances are
-  // built (the shapes take the static solutions the linear part keeps, or factor again).
-  std::mutex factors_lock;
-  const auto factor = [&](int h) {
-    {
-      const std::lock_guard<std::mutex> g(factors_lock);
-      if (auto it = modal.factors.find(h); it != modal.factors.end()) return it->second;
-    }
-    const modal::StiffnessFactor k = modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method);
-    const std::lock_guard<std::mutex> g(factors_lock);
-    return modal.factors.emplace(h, k).first->second;
-  };
+  // The K_h factors, one per pair of conjugate indices, computed in parallel: each lives only
+  // as long as its job, so that at most one per worker is held (a map of them kept every factor
+  // until the stage ended: up to five of the 238k-DOF sector's at once).
+  const auto factor = [&](int h) { return modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method); };
   model.linear = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, factor, pairs, forcing, c.hbm.harmonics,
                                                          ctx.threads);
-  modal.factors.clear();
   model.sector_pairs = pairs;
   model.sector_forcing = forcing;
   ctx.report.stage("receptances", clock.seconds());

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <complex>
 #include <filesystem>
-#include <mutex>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -161,18 +160,12 @@ SectorShapes sector_shapes(const Context& ctx, const forced::ForcedModel& model,
   clock.restart();
   SectorShapes out;
   // K_h^-1 from the receptance stage's solutions where the model kept them, else factors
-  // computed in parallel (one per pair of conjugate indices), each outside the lock.
+  // computed in parallel, one per pair of conjugate indices, each held only by its job.
   const cyclic::CyclicSector& sector = modal.cyclic();
-  std::mutex factors_lock;
-  const auto factor = [&](int h) {
-    const modal::StiffnessFactor k = modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method);
-    const std::lock_guard<std::mutex> g(factors_lock);
-    return modal.factors.emplace(h, k).first->second;
-  };
+  const auto factor = [&](int h) { return modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method); };
   out.u = frf::sector_displacements(sector, modal.bases, factor, model.sector_pairs, *model.sector_forcing, loads,
                                     dynamic_cast<const frf::SectorLinearPart*>(model.linear.get()), ctx.threads);
   out.mesh = modal.mesh;
-  modal.factors.clear();
   if (log::detailed())
     log::info(what + ": modal stage " + io::format_number(modal_seconds) + " s, displacements " +
               io::format_number(clock.seconds()) + " s");
