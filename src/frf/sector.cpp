@@ -470,8 +470,9 @@ std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
             if (!first_factor) first_factor = factor(jobs[static_cast<std::size_t>(j)].front());
             k = h == jobs[static_cast<std::size_t>(j)].front() ? *first_factor : first_factor->conjugate();
           }
-          const auto static_solve = [&](const Eigen::VectorXcd& y) -> Eigen::VectorXcd {
-            if (!solution) return k->solve(Eigen::MatrixXcd(load_map * y)).col(0);
+          // K_h^-1 g for g = load_map y.
+          const auto static_solve = [&](const Eigen::VectorXcd& y, const Eigen::VectorXcd& g) -> Eigen::VectorXcd {
+            if (!solution) return k->solve(Eigen::MatrixXcd(g)).col(0);
             if (conjugated) return (*solution * y.conjugate()).conjugate();
             return *solution * y;
           };
@@ -481,11 +482,11 @@ std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
               Eigen::VectorXcd y = Eigen::VectorXcd::Zero(c + 4);
               y.head(c) = -loads[l].forces[n];
               if (n == 1 && loads[l].excitation) y(c + 3) = 1.0;
+              const Eigen::VectorXcd g = load_map * y;
               Eigen::VectorXcd ur;
               if (n == 0) {
-                ur = static_solve(y);
+                ur = static_solve(y, g);
               } else {
-                const Eigen::VectorXcd g = load_map * y;
                 const double big_w = n * loads[l].w, z = forcing.damping_ratio;
                 const Eigen::VectorXcd modal = basis->phi.adjoint() * g;
                 Eigen::VectorXcd q(modal.size());
@@ -495,7 +496,7 @@ std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
                   if (forcing.residual_flexibility) q[r] -= modal[r] / (wr * wr);
                 }
                 ur = basis->phi * q;
-                if (forcing.residual_flexibility) ur += static_solve(y);
+                if (forcing.residual_flexibility) ur += static_solve(y, g);
               }
               out[l][n] = t * ur;
             }
