@@ -178,7 +178,7 @@ int cmd_modes(Context& ctx) {
   if (c.structure.type != io::StructureType::sector)
     throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
                      "\": `modes` needs an FE sector (structure.type = \"sector\")");
-  ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), /*keep_factors=*/false, 0.0, case_shroud(c));
+  ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), 0.0, case_shroud(c));
   write_modes_csv(ctx, model);
   if (!model.bases.empty()) write_modes_vtu(ctx, model);
   if (!model.failures.empty()) {

@@ -23,7 +23,7 @@ int cmd_static(Context& ctx) {
   if (c.structure.type != io::StructureType::sector)
     throw InputError(c.where("structure.type") + ": structure.type = \"" + io::to_string(c.structure.type) +
                      "\": `static` needs an FE sector");
-  ModalModel model = run_modal_stage(ctx, {}, /*keep_factors=*/false);
+  ModalModel model = run_modal_stage(ctx, {});
   log::Stopwatch clock;
   const double speed = c.static_contact.speed_rpm;
   std::unique_ptr<modal::RotatingOperators> ops;

@@ -110,7 +110,7 @@ std::vector<Crossing> crossings(const std::vector<double>& rpm, const std::map<i
   std::vector<Crossing> rows;
   for (int e : engine_orders) {
     const int h = e % nb;
-    const auto it = sweeps.find(std::min(h, (nb - h) % nb));
+    const auto it = sweeps.find(cyclic::canonical_index(h, nb));
     if (it == sweeps.end()) continue;
     const HarmonicSweep& s = it->second;
     const int nd = cyclic::nodal_diameter(h, nb);

@@ -21,6 +21,8 @@ int nodal_diameter(int h, int sectors) {
   return std::min(m, sectors - m);
 }
 
+int canonical_index(int h, int sectors) { return nodal_diameter(h, sectors); }  // the same number
+
 CyclicSector::CyclicSector(const mesh::Mesh& mesh, const linalg::SparsePair<double>& km)
     : sectors_(mesh.sectors), n_full_(mesh.n_dofs()) {
   SHROUDSIM_CHECK(sectors_ >= 1, "CyclicSector: mesh.sectors must be >= 1");

@@ -39,6 +39,9 @@ Eigen::Matrix3d rotation_z(double angle);
 
 /// Nodal diameter of harmonic index h: min(h mod Nb, Nb - h mod Nb).
 int nodal_diameter(int h, int sectors);
+/// The canonical index of the conjugate pair {h, Nb - h}: min(h, (Nb - h) mod Nb). The modes
+/// and K_h factor of Nb - h are those of h conjugated, so only canonical indices are solved.
+int canonical_index(int h, int sectors);
 
 /// A spring across the sector boundary: node `high_node` of a sector to node `low_node` of
 /// the next one (x_high = R x_low), with stiffness along the rows t1, t2, n of `frame`.

@@ -440,7 +440,7 @@ std::vector<std::vector<Eigen::VectorXcd>> sector_displacements(
   std::map<int, std::vector<int>> by_index;
   for (int n = 0; n <= h_max; ++n) by_index[harmonic_index(n, forcing.engine_order, nb)].push_back(n);
   std::map<int, std::vector<int>> groups;
-  for (const auto& [h, harmonics] : by_index) groups[std::min(h, (nb - h) % nb)].push_back(h);
+  for (const auto& [h, harmonics] : by_index) groups[cyclic::canonical_index(h, nb)].push_back(h);
   std::vector<std::vector<int>> jobs;
   for (auto& [canonical, members] : groups) jobs.push_back(std::move(members));
   linalg::parallel_for(

@@ -77,7 +77,7 @@ std::map<int, CachedModes> cached_modes(const std::function<const cyclic::Cyclic
                                         const std::string& km_key, const std::vector<int>& canonical,
                                         const ModalOptions& options, double speed_rpm,
                                         const std::vector<cyclic::InterfaceSpring>& springs, const StageCache& cache,
-                                        int threads, bool keep_factors) {
+                                        int threads) {
   std::map<int, CachedModes> outcome;
   std::vector<int> to_solve;
   for (int h : canonical) {
@@ -126,7 +126,7 @@ std::map<int, CachedModes> cached_modes(const std::function<const cyclic::Cyclic
       o.result.report.message = e.what();
     }
     o.seconds = watch.seconds();
-    if (!keep_factors) o.result.stiffness = StiffnessFactor();  // free the factor now
+    o.result.stiffness = StiffnessFactor();  // free the factor now
     const auto& r = o.result.report;
     std::string line =
         "modes h = " + std::to_string(h) + " (ND " + std::to_string(cyclic::nodal_diameter(h, nb)) + "): ";

@@ -49,19 +49,19 @@ SectorMatrices assemble_matrices(const mesh::Mesh& mesh, const fe::Material& mat
 
 /// The modes of one canonical harmonic index.
 struct CachedModes {
-  ModalResult result;  ///< result.report.method = "cache" when reused; result.stiffness kept only if asked
+  ModalResult result;  ///< result.report.method = "cache" when reused; result.stiffness empty
   bool reused = false;
   double seconds = 0.0;
 };
 /// Modes of the canonical harmonic indices `canonical`: each from the cache, or solved
 /// (modal::solve_harmonic on sector(), harmonic indices in parallel on `threads` workers) and
 /// cached when it converged. A failed solve is returned with its status and message (never
-/// thrown). sector() is called only when something must be solved. keep_factors: keep the K_h
-/// factorization of each solve in result.stiffness. One log line per solve.
+/// thrown). sector() is called only when something must be solved. Each solve's K_h factor is
+/// freed as the solve ends (at most one per worker is held). One log line per solve.
 std::map<int, CachedModes> cached_modes(const std::function<const cyclic::CyclicSector&()>& sector,
                                         const std::string& matrices_key, const std::vector<int>& canonical,
                                         const ModalOptions& options, double speed_rpm,
                                         const std::vector<cyclic::InterfaceSpring>& springs, const StageCache& cache,
-                                        int threads, bool keep_factors);
+                                        int threads);
 
 }  // namespace shroudsim::modal

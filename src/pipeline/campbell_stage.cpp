@@ -159,7 +159,7 @@ void write_campbell_csv(const Context& ctx, const ModalModel& model, const std::
   camp << "speed_rpm,harmonic_index,nodal_diameter,mode,frequency_hz\n";
   for (std::size_t i = 0; i < rpm.size(); ++i) {
     for (const auto& [h, b] : model.bases) {
-      const Eigen::VectorXd& f = sweeps.at(std::min(h, (nb - h) % nb)).f[i];
+      const Eigen::VectorXd& f = sweeps.at(cyclic::canonical_index(h, nb)).f[i];
       for (Eigen::Index r = 0; r < f.size(); ++r)
         camp << io::format_number(rpm[i]) << ',' << h << ',' << cyclic::nodal_diameter(h, nb) << ',' << r + 1 << ','
              << io::format_number(f(r)) << '\n';
@@ -201,7 +201,7 @@ CampbellOutcome run_campbell(Context& ctx) {
   std::sort(hs.begin(), hs.end());
   hs.erase(std::unique(hs.begin(), hs.end()), hs.end());
 
-  ModalModel model = run_modal_stage(ctx, hs, /*keep_factors=*/false, 0.0, case_shroud(c));
+  ModalModel model = run_modal_stage(ctx, hs, 0.0, case_shroud(c));
   log::Stopwatch clock;
   write_modes_csv(ctx, model);
 
@@ -218,7 +218,7 @@ CampbellOutcome run_campbell(Context& ctx) {
 
   // Canonical harmonic indices (h and Nb - h share frequencies) that have modes at rest.
   Sweeps sweeps;
-  for (const auto& [h, b] : model.bases) sweeps[std::min(h, (nb - h) % nb)].f.assign(np, Eigen::VectorXd());
+  for (const auto& [h, b] : model.bases) sweeps[cyclic::canonical_index(h, nb)].f.assign(np, Eigen::VectorXd());
   // Frequencies at rest of canonical h (from h or from Nb - h: equal spectra).
   const AtRest at_rest = [&](int h) {
     auto it = model.bases.find(h);

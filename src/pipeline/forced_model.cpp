@@ -109,7 +109,7 @@ ForcedModel make_sector_model(Context& ctx) {
   // speed, on the sector at rest plus its rotating operators (docs/physics.md section 8).
   std::optional<frf::StaticShroud> static_state;
   if (c.contact.normal_preload_static) {
-    ModalModel rest = run_modal_stage(ctx, {}, /*keep_factors=*/false);
+    ModalModel rest = run_modal_stage(ctx, {});
     std::unique_ptr<modal::RotatingOperators> ops;
     if (c.excitation.speed_rpm > 0.0)
       ops = std::make_unique<modal::RotatingOperators>(
@@ -122,8 +122,8 @@ ForcedModel make_sector_model(Context& ctx) {
   // modal solve) differs from it in round-off, so a run with the modes cached and one that solves them would
   // give different curves where the continuation's path is sensitive to round-off (the
   // default case: 649 points in two pieces against 343 in one, the same located peak).
-  auto kept_modal = std::make_shared<ModalModel>(run_modal_stage(ctx, needed, /*keep_factors=*/false,
-                                                                 c.excitation.speed_rpm));  // > 0: at that speed
+  auto kept_modal =
+      std::make_shared<ModalModel>(run_modal_stage(ctx, needed, c.excitation.speed_rpm));  // > 0: at that speed
   ModalModel& modal = *kept_modal;
   if (!modal.failures.empty()) throw NumericalError("modal stage failed: " + modal.failures.front());
   const mesh::Mesh& mesh = modal.mesh;

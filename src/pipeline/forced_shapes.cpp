@@ -151,8 +151,7 @@ SectorShapes sector_shapes(const Context& ctx, const forced::ForcedModel& model,
     modal_ctx.config = c;
     modal_ctx.out_dir = ctx.out_dir;
     modal_ctx.threads = ctx.threads;
-    kept = std::make_shared<ModalModel>(
-        run_modal_stage(modal_ctx, forced_harmonic_indices(c), false, c.excitation.speed_rpm));
+    kept = std::make_shared<ModalModel>(run_modal_stage(modal_ctx, forced_harmonic_indices(c), c.excitation.speed_rpm));
   }
   ModalModel& modal = *kept;
   if (!modal.failures.empty()) throw NumericalError(what + ": modal stage failed: " + modal.failures.front());

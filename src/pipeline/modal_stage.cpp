@@ -60,15 +60,6 @@ std::vector<cyclic::InterfaceSpring> shroud_springs(const io::Case& c, const mes
   }
 }
 
-modal::StiffnessFactor ModalModel::stiffness_factor(int h) {
-  auto it = factors.find(h);
-  if (it != factors.end()) return it->second;
-  const int nb = mesh.sectors;
-  auto conj = factors.find((nb - h) % nb);
-  if (conj != factors.end()) return factors[h] = conj->second.conjugate();
-  return factors[h] = modal::factor_harmonic_stiffness(cyclic(), h, options.factor_method);
-}
-
 std::vector<int> modal_harmonic_indices(const io::Case& c) {
   const int nb = c.structure.sectors;
   std::vector<int> hs;
@@ -87,8 +78,7 @@ std::vector<int> modal_harmonic_indices(const io::Case& c) {
   return hs;
 }
 
-ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors, double speed_rpm,
-                           Shroud shroud) {
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, double speed_rpm, Shroud shroud) {
   const io::Case& c = ctx.config;
   ModalModel model;
   model.mesh = obtain_mesh(ctx);
@@ -174,14 +164,14 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
 
   // Canonical harmonic indices: h and Nb - h share the solve of min(h, Nb - h).
   std::vector<int> canonical;
-  for (int h : harmonic_indices) canonical.push_back(std::min(h, (nb - h) % nb));
+  for (int h : harmonic_indices) canonical.push_back(cyclic::canonical_index(h, nb));
   std::sort(canonical.begin(), canonical.end());
   canonical.erase(std::unique(canonical.begin(), canonical.end()), canonical.end());
 
   clock.restart();
   std::map<int, modal::CachedModes> outcome =
       modal::cached_modes([&model]() -> const cyclic::CyclicSector& { return model.cyclic(); }, km_key, canonical,
-                          model.options, speed_rpm, model.interface, cache, ctx.threads, keep_factors);
+                          model.options, speed_rpm, model.interface, cache, ctx.threads);
   if (std::any_of(outcome.begin(), outcome.end(), [](const auto& o) { return !o.second.reused; }))
     report["reduced_dofs"] = model.cyclic().n_reduced();  // built for the solves
 
@@ -222,13 +212,11 @@ ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indice
       continue;
     }
     if (!r.message.empty()) ctx.report.warn("harmonic index " + std::to_string(h) + ": " + r.message);
-    if (keep_factors && o.result.stiffness.valid()) model.factors[h] = o.result.stiffness;
-    o.result.stiffness = modal::StiffnessFactor();  // released here unless kept
   }
   report["harmonic_indices"] = harmonic_indices;
   report["solved"] = per_h;
   for (int h : harmonic_indices) {
-    const int hc = std::min(h, (nb - h) % nb);
+    const int hc = cyclic::canonical_index(h, nb);
     const modal::CachedModes& o = outcome.at(hc);
     if (!o.result.report.ok()) continue;
     model.bases[h] = h == hc ? o.result.basis : o.result.basis.conjugate(h);

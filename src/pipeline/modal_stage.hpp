@@ -13,7 +13,6 @@
 //   ModalModel model = run_modal_stage(ctx, {0, 1, 2});
 //   const modal::ModalBasis& b = model.bases.at(h);               // omega [rad/s], phi
 //   const cyclic::CyclicSector& cs = model.cyclic();              // T_h: cs.expansion(h)
-//   modal::StiffnessFactor Kh = model.stiffness_factor(h);        // K_h^{-1} (kept, lazy)
 #include <map>
 #include <memory>
 #include <string>
@@ -32,18 +31,15 @@ struct ModalModel {
   mesh::Mesh mesh;
   fe::Material material;
   modal::ModalOptions options;
-  double speed_rpm = 0.0;                         ///< > 0: K below is the rotating stiffness at this speed
-  linalg::SparsePair<double> km;                  ///< sector K [N/m], M [kg] on all 3 * n_nodes DOFs
-  std::map<int, modal::ModalBasis> bases;         ///< per harmonic index (reduced DOFs of that h)
-  std::map<int, modal::StiffnessFactor> factors;  ///< K_h factors kept from the solves (h with shift 0)
-  std::vector<std::string> failures;              ///< harmonic indices whose modes failed (message each)
+  double speed_rpm = 0.0;                  ///< > 0: K below is the rotating stiffness at this speed
+  linalg::SparsePair<double> km;           ///< sector K [N/m], M [kg] on all 3 * n_nodes DOFs
+  std::map<int, modal::ModalBasis> bases;  ///< per harmonic index (reduced DOFs of that h)
+  std::vector<std::string> failures;       ///< harmonic indices whose modes failed (message each)
   /// The stuck shroud's springs (empty: open shroud); every reduction of cyclic() has them.
   std::vector<cyclic::InterfaceSpring> interface;
 
   /// The cyclic reduction of the sector (built on first use).
   const cyclic::CyclicSector& cyclic();
-  /// The factorization of K_h: kept from the modal solve if there was one, else computed.
-  modal::StiffnessFactor stiffness_factor(int harmonic_index);
 
  private:
   std::unique_ptr<cyclic::CyclicSector> cyclic_;
@@ -55,9 +51,8 @@ std::vector<int> modal_harmonic_indices(const io::Case& c);
 
 /// Mesh (obtain_mesh), K and M, and the modes of `harmonic_indices` (cached where possible).
 /// A harmonic index whose solve fails is listed in ModalModel::failures (the caller writes
-/// what converged and throws NumericalError). keep_factors: keep the K_h factorizations of
-/// the solves in ModalModel::factors (memory: about nnz(L) * 16 bytes each; a harmonic index
-/// read from the cache gets its factor on demand from stiffness_factor()).
+/// what converged and throws NumericalError). Each K_h factorization is freed when its solve
+/// ends (modal::factor_harmonic_stiffness makes one again where it is needed).
 /// speed_rpm > 0: the sector spins at that speed (rad/s: Omega = 2 pi rpm / 60) and
 /// ModalModel::km.K becomes the rotating stiffness K + Omega^2 (K_sigma1 - M_spin)
 /// (centrifugal stiffening and spin softening, modal/rotating.hpp), so the modes, the
@@ -68,8 +63,8 @@ std::vector<int> modal_harmonic_indices(const io::Case& c);
 /// of the prestress and the K_h factors; the cache keys include the springs.
 /// "contact": the pairs the static shroud contact at rest closes (contact.interference) tied.
 enum class Shroud { open, stuck, contact };
-ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, bool keep_factors = true,
-                           double speed_rpm = 0.0, Shroud shroud = Shroud::open);
+ModalModel run_modal_stage(Context& ctx, const std::vector<int>& harmonic_indices, double speed_rpm = 0.0,
+                           Shroud shroud = Shroud::open);
 
 /// The shroud state `modes` and `campbell` use: the case's modal.shroud.
 Shroud case_shroud(const io::Case& c);

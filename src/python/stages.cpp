@@ -288,8 +288,8 @@ py::object run_modes(const CaseSource& c, const RunOptions& o, bool shapes) {
         if (cc.structure.type != io::StructureType::sector)
           throw InputError(cc.where("structure.type") + ": structure.type = \"" + io::to_string(cc.structure.type) +
                            "\": `modes` needs an FE sector (structure.type = \"sector\")");
-        pipeline::ModalModel model = pipeline::run_modal_stage(ctx, pipeline::modal_harmonic_indices(cc),
-                                                               /*keep_factors=*/false, 0.0, pipeline::case_shroud(cc));
+        pipeline::ModalModel model =
+            pipeline::run_modal_stage(ctx, pipeline::modal_harmonic_indices(cc), 0.0, pipeline::case_shroud(cc));
         pipeline::write_modes_csv(ctx, model);
         if (write_vtu && !model.bases.empty()) pipeline::write_modes_vtu(ctx, model);
         for (const auto& [h, b] : model.bases) {

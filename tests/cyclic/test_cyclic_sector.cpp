@@ -129,6 +129,14 @@ TEST(CyclicSector, ExpansionSatisfiesTheCyclicConstraint) {
   EXPECT_EQ(nodal_diameter(5, nb), 2);
   EXPECT_EQ(nodal_diameter(3, nb), 3);
   EXPECT_EQ(nodal_diameter(9, nb), 2);  // engine order 9 aliases to h = 2
+  // Each conjugate pair {h, Nb - h} has one canonical index, its smaller member.
+  for (int n : {1, 2, 7, 8}) {
+    for (int h = 0; h < n; ++h) {
+      const int c = canonical_index(h, n);
+      EXPECT_EQ(c, canonical_index((n - h) % n, n)) << "n = " << n << ", h = " << h;
+      EXPECT_EQ(c, std::min(h, (n - h) % n)) << "n = " << n << ", h = " << h;
+    }
+  }
 }
 
 TEST(CyclicSector, MismatchedPairsAreRejected) {
