@@ -21,6 +21,7 @@
 #include "io/output.hpp"
 #include "io/results_folder.hpp"
 #include "io/schema.hpp"
+#include "mesh/gmsh_module.hpp"
 #include "pipeline/study_stage.hpp"
 
 namespace shroudsim::app {
@@ -110,6 +111,9 @@ nlohmann::json run_report(const Context& ctx, const std::string& command, const 
   j["finished_utc"] = now_utc();
   j["total_seconds"] = ctx.report.total_seconds();
   j["peak_memory_mib"] = log::peak_memory_mib();
+  // null: no mesh was read or made with gmsh (the mesh cache served it, or no mesh)
+  const std::filesystem::path gmsh = mesh::detail::gmsh_module_path();
+  j["gmsh_module"] = gmsh.empty() ? nlohmann::json() : nlohmann::json(gmsh.string());
   j["versions"] = {{"shroudsim", SHROUDSIM_VERSION},
                    {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
                                  std::to_string(EIGEN_MINOR_VERSION)},

@@ -13,6 +13,7 @@ namespace shroudsim::modal {
 namespace {
 
 constexpr std::uint64_t kMagicBasis = 0x32534142444f4d53ull;  // "SMODBAS2": key and checksum
+constexpr std::uint64_t kMagicMesh = 0x3248534548534d53ull;   // "SMSHESH2" (version digit last)
 
 // Largest cache file read (50 modes of a 240k-DOF sector are about 0.2 GB).
 constexpr std::uintmax_t kMaxCacheBytes = 8ull << 30;
@@ -112,7 +113,120 @@ std::optional<std::istringstream> read_entry(const std::filesystem::path& path, 
   return in;
 }
 
+template <typename Matrix>
+void put_matrix(std::ostream& out, const Matrix& m) {
+  put<std::int64_t>(out, m.rows());
+  put<std::int64_t>(out, m.cols());
+  out.write(reinterpret_cast<const char*>(m.data()), static_cast<std::streamsize>(sizeof(*m.data()) * m.size()));
+}
+template <typename Matrix>
+bool get_matrix(std::istream& in, Matrix& m, std::int64_t max_entries) {
+  std::int64_t rows = 0, cols = 0;
+  if (!get(in, rows) || !get(in, cols) || rows < 0 || cols < 0) return false;
+  if (Matrix::ColsAtCompileTime != Eigen::Dynamic && cols != Matrix::ColsAtCompileTime) return false;
+  if (cols > 0 && rows > max_entries / cols) return false;
+  m.resize(rows, cols);
+  return static_cast<bool>(
+      in.read(reinterpret_cast<char*>(m.data()), static_cast<std::streamsize>(sizeof(*m.data()) * m.size())));
+}
+void put_string(std::ostream& out, const std::string& s) {
+  put<std::int64_t>(out, static_cast<std::int64_t>(s.size()));
+  out.write(s.data(), static_cast<std::streamsize>(s.size()));
+}
+bool get_string(std::istream& in, std::string& s) {
+  std::int64_t n = 0;
+  if (!get(in, n) || n < 0 || n > 4096) return false;
+  s.assign(static_cast<std::size_t>(n), '\0');
+  return static_cast<bool>(in.read(s.data(), n));
+}
+void put_pairs(std::ostream& out, const std::vector<std::pair<int, int>>& v) {
+  put<std::int64_t>(out, static_cast<std::int64_t>(v.size()));
+  for (const auto& [a, b] : v) {
+    put<std::int32_t>(out, a);
+    put<std::int32_t>(out, b);
+  }
+}
+bool get_pairs(std::istream& in, std::vector<std::pair<int, int>>& v, std::int64_t max_count) {
+  std::int64_t n = 0;
+  if (!get(in, n) || n < 0 || n > max_count) return false;
+  v.resize(static_cast<std::size_t>(n));
+  for (auto& [a, b] : v) {
+    std::int32_t x = 0, y = 0;
+    if (!get(in, x) || !get(in, y)) return false;
+    a = x;
+    b = y;
+  }
+  return true;
+}
+
 }  // namespace
+
+void save_mesh(const std::filesystem::path& path, const std::string& key, const mesh::Mesh& m) {
+  write_atomic(path, kMagicMesh, key, [&](std::ostream& out) {
+    put<std::int32_t>(out, m.element_order);
+    put<std::int32_t>(out, m.sectors);
+    put_matrix(out, m.nodes);
+    put_matrix(out, m.tets);
+    put<std::int64_t>(out, static_cast<std::int64_t>(m.node_sets.size()));
+    for (const auto& [name, nodes] : m.node_sets) {
+      put_string(out, name);
+      put_array(out, nodes.data(), static_cast<std::int64_t>(nodes.size()));
+    }
+    put<std::int64_t>(out, static_cast<std::int64_t>(m.surface_triangles.size()));
+    for (const auto& [name, tri] : m.surface_triangles) {
+      put_string(out, name);
+      put_matrix(out, tri);
+    }
+    put_pairs(out, m.cyclic_pairs);
+    put_pairs(out, m.shroud_pairs);
+  });
+}
+
+std::optional<mesh::Mesh> load_mesh(const std::filesystem::path& path, const std::string& key, std::string* problem) {
+  auto in = read_entry(path, kMagicMesh, key, problem);
+  if (!in) return std::nullopt;
+  auto bad = [&]() -> std::optional<mesh::Mesh> {
+    if (problem) *problem = "malformed payload";
+    return std::nullopt;
+  };
+  constexpr std::int64_t kMaxEntries = std::int64_t{1} << 34;  // bounded by kMaxCacheBytes anyway
+  constexpr std::int64_t kMaxGroups = 64;
+  mesh::Mesh m;
+  std::int32_t order = 0, sectors = 0;
+  if (!get(*in, order) || !get(*in, sectors) || (order != 1 && order != 2) || sectors < 1) return bad();
+  m.element_order = order;
+  m.sectors = sectors;
+  if (!get_matrix(*in, m.nodes, kMaxEntries) || !m.nodes.allFinite()) return bad();
+  if (!get_matrix(*in, m.tets, kMaxEntries) || m.tets.cols() != (order == 1 ? 4 : 10)) return bad();
+  const int n = m.n_nodes();
+  auto in_range = [n](const auto& v) { return v.size() == 0 || (v.minCoeff() >= 0 && v.maxCoeff() < n); };
+  if (!in_range(m.tets.reshaped())) return bad();
+  std::int64_t groups = 0;
+  if (!get(*in, groups) || groups < 0 || groups > kMaxGroups) return bad();
+  for (std::int64_t g = 0; g < groups; ++g) {
+    std::string name;
+    std::int64_t count = 0;
+    if (!get_string(*in, name) || !get(*in, count) || count < 0 || count > n) return bad();
+    std::vector<int> nodes(static_cast<std::size_t>(count));
+    if (!in->read(reinterpret_cast<char*>(nodes.data()), static_cast<std::streamsize>(sizeof(int) * count)))
+      return bad();
+    if (!in_range(Eigen::Map<const Eigen::VectorXi>(nodes.data(), count))) return bad();
+    m.node_sets[name] = std::move(nodes);
+  }
+  if (!get(*in, groups) || groups < 0 || groups > kMaxGroups) return bad();
+  for (std::int64_t g = 0; g < groups; ++g) {
+    std::string name;
+    mesh::ConnectivityMatrix tri;
+    if (!get_string(*in, name) || !get_matrix(*in, tri, kMaxEntries) || !in_range(tri.reshaped())) return bad();
+    m.surface_triangles[name] = std::move(tri);
+  }
+  if (!get_pairs(*in, m.cyclic_pairs, n) || !get_pairs(*in, m.shroud_pairs, n)) return bad();
+  for (const auto* pairs : {&m.cyclic_pairs, &m.shroud_pairs})
+    for (const auto& [p, q] : *pairs)
+      if (p < 0 || p >= n || q < 0 || q >= n) return bad();
+  if (in->peek() != std::char_traits<char>::eof()) return bad();
+  return m;
+}
 
 void save_basis(const std::filesystem::path& path, const std::string& key, const ModalBasis& basis) {
   write_atomic(path, kMagicBasis, key, [&](std::ostream& out) {

@@ -1,5 +1,5 @@
 #pragma once
-// On-disk cache of modal bases (binary, this machine's byte order). K and M are not cached:
+// On-disk cache of modal bases and of read meshes (binary, this machine's byte order). K and M are not cached:
 // assembling them is faster than reading them back (modal/modal_stage.hpp).
 // A file holds a magic tag (kind and format version), the key it was written under, the
 // payload and a 64-bit checksum (FNV-1a) of all of that. A file that does not match (other
@@ -13,6 +13,7 @@
 #include <string>
 
 #include "linalg/sparse.hpp"
+#include "mesh/mesh.hpp"
 #include "modal/eigensolver.hpp"
 
 namespace shroudsim::modal {
@@ -21,5 +22,11 @@ namespace shroudsim::modal {
 void save_basis(const std::filesystem::path& path, const std::string& key, const ModalBasis& basis);
 std::optional<ModalBasis> load_basis(const std::filesystem::path& path, const std::string& key,
                                      std::string* problem = nullptr);
+
+/// A mesh as read and checked from a .msh file (pipeline/mesh_stage.cpp keys it by the
+/// file's bytes and the read options): reading it back needs no gmsh.
+void save_mesh(const std::filesystem::path& path, const std::string& key, const mesh::Mesh& mesh);
+std::optional<mesh::Mesh> load_mesh(const std::filesystem::path& path, const std::string& key,
+                                    std::string* problem = nullptr);
 
 }  // namespace shroudsim::modal

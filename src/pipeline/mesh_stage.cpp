@@ -7,10 +7,12 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "fe/fingerprint.hpp"
 #include "io/output.hpp"
 #include "mesh/checks.hpp"
 #include "mesh/msh_reader.hpp"
 #include "mesh/sector_generator.hpp"
+#include "modal/cache.hpp"
 #include "pipeline/context.hpp"
 
 namespace shroudsim::pipeline {
@@ -28,6 +30,52 @@ std::string read_text(const fs::path& p) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// Bump when the reader's result for the same file could change (checks, ordering, groups).
+constexpr const char* kMeshReadVersion = "mesh-read-1";
+
+// mesh::read_sector_mesh, through the case's cache: the mesh as read and checked is kept in
+// .cache/mesh-<key>.bin under a fingerprint of the file's bytes and the read options, so a
+// run whose .msh is unchanged reads it back without gmsh (whose module then is never
+// loaded: 0.15 s of every start, mesh/gmsh_module.hpp). A changed or unusable entry is
+// read again through gmsh and rewritten.
+mesh::Mesh read_mesh_cached(Context& ctx, const fs::path& file, const mesh::ReadOptions& options) {
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  constexpr std::uintmax_t kMaxHashedBytes = 4ull << 30;  // larger files are read each time
+  if (ec || !fs::is_regular_file(file, ec) || size > kMaxHashedBytes) {
+    ctx.report.section("mesh")["read_from"] = "gmsh";
+    return mesh::read_sector_mesh(file, options);
+  }
+  std::string bytes(size, '\0');
+  {
+    std::ifstream in(file, std::ios::binary);
+    if (!in.read(bytes.data(), static_cast<std::streamsize>(size))) return mesh::read_sector_mesh(file, options);
+  }
+  fe::Hasher h;
+  h.add(std::string(kMeshReadVersion));
+  h.add_bytes(bytes.data(), bytes.size());
+  h.add(options.sectors);
+  h.add(options.match_tolerance);
+  const std::string key = h.hex();
+  const fs::path entry = ctx.config.directory / ".cache" / ("mesh-" + key + ".bin");
+  auto& j = ctx.report.section("mesh");
+  j["cache_entry"] = entry.string();
+  std::string problem;
+  if (auto m = modal::load_mesh(entry, key, &problem)) {
+    j["read_from"] = "cache";
+    return std::move(*m);
+  }
+  if (!problem.empty()) ctx.report.warn("cache entry " + entry.string() + " is corrupt (" + problem + "); recomputing");
+  mesh::Mesh m = mesh::read_sector_mesh(file, options);
+  j["read_from"] = "gmsh";
+  try {
+    modal::save_mesh(entry, key, m);
+  } catch (const std::exception& e) {
+    ctx.report.warn(std::string("cannot write the mesh cache entry: ") + e.what());
+  }
+  return m;
 }
 
 void describe_mesh(Context& ctx, const mesh::Mesh& m, const fs::path& file, bool generated, bool reused) {
@@ -73,7 +121,7 @@ mesh::Mesh obtain_mesh(Context& ctx) {
   if (!c.structure.mesh.empty()) {
     mesh::Mesh m;
     try {
-      m = mesh::read_sector_mesh(c.structure.mesh, {c.structure.sectors, 1e-6});
+      m = read_mesh_cached(ctx, c.structure.mesh, {c.structure.sectors, 1e-6});
     } catch (const InputError& e) {
       throw InputError(c.locations.at("structure.mesh") + ": structure.mesh: " + e.what());
     }
@@ -91,7 +139,7 @@ mesh::Mesh obtain_mesh(Context& ctx) {
     // The program's own mesh, unreadable (truncated, changed): regenerated, not blamed on the
     // user.
     try {
-      mesh::Mesh m = mesh::read_sector_mesh(file, {c.structure.sectors, 1e-6});
+      mesh::Mesh m = read_mesh_cached(ctx, file, {c.structure.sectors, 1e-6});
       ctx.report.stage("mesh", clock.seconds(), reused);
       describe_mesh(ctx, m, file, true, reused);
       ctx.report.section("mesh")["analytic_volume_m3"] = geometry.analytic_volume();
@@ -117,7 +165,7 @@ mesh::Mesh obtain_mesh(Context& ctx) {
     io::write_file_atomic(key_file, key);
     ctx.report.section("mesh")["generation_seconds"] = r.seconds;
   }
-  mesh::Mesh m = mesh::read_sector_mesh(file, {c.structure.sectors, 1e-6});
+  mesh::Mesh m = read_mesh_cached(ctx, file, {c.structure.sectors, 1e-6});
   ctx.report.stage("mesh", clock.seconds(), reused);
   describe_mesh(ctx, m, file, true, reused);
   auto& j = ctx.report.section("mesh");

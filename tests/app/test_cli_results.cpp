@@ -180,6 +180,33 @@ TEST(CliResults, CorruptedCacheEntriesAreRecomputedNotUsed) {
   EXPECT_EQ(runs, 3 * static_cast<int>(entries.size()));
 }
 
+// The mesh as read and checked is cached under the .msh file's bytes: a run whose mesh is
+// unchanged reads it back without loading gmsh (mesh/gmsh_module.hpp), and any change to
+// the file reads it through gmsh again. The modes are those of the first reading.
+TEST(CliResults, AnUnchangedMeshIsReadBackWithoutGmsh) {
+  Scratch s("results_mesh_cache");
+  s.write("c.toml", kQuickCase);
+  ASSERT_EQ(s.run("mesh c.toml --out m --quiet").status, 0);
+  const std::string made = slurp(s.dir() / "m" / "run.json");
+  EXPECT_NE(made.find("\"read_from\": \"gmsh\""), std::string::npos) << made;
+  EXPECT_NE(made.find("\"gmsh_module\": \"/"), std::string::npos) << made;  // generated: gmsh loaded
+
+  ASSERT_EQ(s.run("modes c.toml --out a --quiet").status, 0);
+  const std::string cached = slurp(s.dir() / "a" / "run.json");
+  EXPECT_NE(cached.find("\"read_from\": \"cache\""), std::string::npos) << cached;
+  EXPECT_NE(cached.find("\"gmsh_module\": null"), std::string::npos) << cached;
+
+  // One byte more (a blank line at the end: the same mesh to gmsh): read through gmsh again.
+  const fs::path msh = s.dir() / "meshes" / "coarse.msh";
+  ASSERT_TRUE(fs::exists(msh));
+  std::ofstream(msh, std::ios::app) << "\n";
+  ASSERT_EQ(s.run("modes c.toml --out b --quiet").status, 0);
+  const std::string reread = slurp(s.dir() / "b" / "run.json");
+  EXPECT_NE(reread.find("\"read_from\": \"gmsh\""), std::string::npos) << reread;
+  EXPECT_NE(reread.find("\"gmsh_module\": \"/"), std::string::npos) << reread;
+  EXPECT_EQ(slurp(s.dir() / "b" / "modes.csv"), slurp(s.dir() / "a" / "modes.csv"));
+}
+
 const char* kLumped = R"(name = "lumped"
 [structure]
 type = "lumped"

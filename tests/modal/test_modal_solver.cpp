@@ -288,6 +288,48 @@ TEST(ModalCache, RoundTripsBases) {
   std::filesystem::remove_all(dir);
 }
 
+// A mesh entry gives back every field as it was written (the mesh stage's cache of read
+// meshes, pipeline/mesh_stage.cpp), and only under its own key.
+TEST(ModalCache, RoundTripsMeshes) {
+  const auto dir = std::filesystem::temp_directory_path() / "shroudsim_mesh_cache_test";
+  std::filesystem::remove_all(dir);
+  mesh::Mesh m;
+  m.nodes = mesh::NodeMatrix::Random(12, 3);
+  m.tets.resize(2, 10);
+  for (Eigen::Index i = 0; i < m.tets.size(); ++i) m.tets.data()[i] = static_cast<int>((7 * i + 3) % 12);
+  m.element_order = 2;
+  m.sectors = 7;
+  m.node_sets = {{"hub", {0, 1, 2}}, {"shroud_low", {4, 5}}, {"shroud_high", {9, 11}}};
+  m.surface_triangles["shroud_low"] = mesh::ConnectivityMatrix::Constant(1, 6, 5);
+  m.surface_triangles["hub"] = mesh::ConnectivityMatrix::Constant(2, 6, 1);
+  m.cyclic_pairs = {{0, 6}, {1, 7}};
+  m.shroud_pairs = {{4, 9}, {5, 11}};
+  save_mesh(dir / "m.bin", "key-m", m);
+  const auto r = load_mesh(dir / "m.bin", "key-m");
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->nodes, m.nodes);
+  EXPECT_EQ(r->tets, m.tets);
+  EXPECT_EQ(r->element_order, 2);
+  EXPECT_EQ(r->sectors, 7);
+  EXPECT_EQ(r->node_sets, m.node_sets);
+  ASSERT_EQ(r->surface_triangles.size(), 2u);
+  for (const auto& [name, tri] : m.surface_triangles) EXPECT_EQ(r->surface_triangles.at(name), tri) << name;
+  EXPECT_EQ(r->cyclic_pairs, m.cyclic_pairs);
+  EXPECT_EQ(r->shroud_pairs, m.shroud_pairs);
+  std::string problem;
+  EXPECT_FALSE(load_mesh(dir / "m.bin", "key-other", &problem).has_value());
+  EXPECT_FALSE(problem.empty());
+  // A modes entry is not a mesh (another kind), nor the other way round.
+  save_basis(dir / "b.bin", "key-m", ModalBasis{0, Eigen::VectorXd::Ones(1), Eigen::MatrixXcd::Ones(3, 1)});
+  problem.clear();
+  EXPECT_FALSE(load_mesh(dir / "b.bin", "key-m", &problem).has_value());
+  EXPECT_FALSE(problem.empty());
+  problem.clear();
+  EXPECT_FALSE(load_basis(dir / "m.bin", "key-m", &problem).has_value());
+  EXPECT_FALSE(problem.empty());
+  std::filesystem::remove_all(dir);
+}
+
 // Any changed byte of an entry (at offsets spread over the header, the payload and the
 // checksum) or a truncation is detected: never used, always with a reason.
 TEST(ModalCache, CorruptedBytesAreDetectedAtEveryOffset) {
