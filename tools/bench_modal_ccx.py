@@ -9,7 +9,8 @@ timed with each thread count T (default 1 and 2; T threads in every layer: shrou
 workers, OpenBLAS, CalculiX's solver):
   - `shroudsim modes CASE --threads T` (assembly, cyclic reduction, M modes of every harmonic
     index, modes.csv, modes.vtu, the plot), from the mesh just made, with an empty modal cache
-    (the case is copied into the work folder, whose `.cache` is emptied before each run);
+    (the case is copied into the work folder, whose modal cache entries are removed before
+    each run; the mesh as read, cached by `shroudsim mesh`, is read back without gmsh);
   - `ccx` (CalculiX) on the same mesh: C3D10 elements, the hub clamped, the cyclic faces tied
     by *TIE, CYCLIC SYMMETRY and *CYCLIC SYMMETRY MODEL (N = Nb, axis z), *FREQUENCY 2 M (CalculiX
     counts each cyclic mode twice, as its two real forms),
@@ -20,6 +21,7 @@ has its own element and its own cyclic constraint). Needs /usr/bin/python3 with 
 `ccx` (Debian package calculix-ccx); one run each: quote ratios from one run.
 """
 import argparse
+import glob
 import math
 import os
 import re
@@ -171,7 +173,10 @@ def main(argv):
             # starts one thread per core whatever --threads says), CalculiX's solver threads.
             env = dict(os.environ, OMP_NUM_THREADS=str(t), OPENBLAS_NUM_THREADS=str(t),
                        CCX_NPROC_EQUATION_SOLVER=str(t), CCX_NPROC_STIFFNESS=str(t))
-            shutil.rmtree(os.path.join(work, ".cache"), ignore_errors=True)
+            # The modal entries only: the mesh entry the `mesh` command left (the mesh as read and
+            # checked, .cache/mesh-*.bin) stays, as in a user's second command on a mesh.
+            for entry in glob.glob(os.path.join(work, ".cache", "modes-*")):
+                os.remove(entry)
             out = os.path.join(work, f"modes{t}")
             t0 = time.perf_counter()
             subprocess.run([binary, "modes", local_case, "--out", out, "--quiet", "--threads", str(t)] + sets,

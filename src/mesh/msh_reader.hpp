@@ -17,6 +17,10 @@ struct ReadOptions {
 /// (4 or 10 nodes; group "sector" if present, else every 3D element); cyclic and shroud
 /// nodes match under the rotation within the tolerance (the worst pair is reported
 /// otherwise); no element is inverted or degenerate.
+/// The reader's version, part of the key under which pipeline/mesh_stage.cpp caches what it
+/// read: change it whenever read_sector_mesh can give another Mesh for the same file and options.
+inline constexpr const char* kReaderVersion = "msh-reader-1";
+
 Mesh read_sector_mesh(const std::filesystem::path& file, const ReadOptions& options);
 
 }  // namespace shroudsim::mesh

@@ -32,9 +32,6 @@ std::string read_text(const fs::path& p) {
   return s.str();
 }
 
-// Bump when the reader's result for the same file could change (checks, ordering, groups).
-constexpr const char* kMeshReadVersion = "mesh-read-1";
-
 // mesh::read_sector_mesh, through the case's cache: the mesh as read and checked is kept in
 // .cache/mesh-<key>.bin under a fingerprint of the file's bytes and the read options, so a
 // run whose .msh is unchanged reads it back without gmsh (whose module then is never
@@ -51,10 +48,13 @@ mesh::Mesh read_mesh_cached(Context& ctx, const fs::path& file, const mesh::Read
   std::string bytes(size, '\0');
   {
     std::ifstream in(file, std::ios::binary);
-    if (!in.read(bytes.data(), static_cast<std::streamsize>(size))) return mesh::read_sector_mesh(file, options);
+    if (!in.read(bytes.data(), static_cast<std::streamsize>(size))) {
+      ctx.report.section("mesh")["read_from"] = "gmsh";
+      return mesh::read_sector_mesh(file, options);
+    }
   }
   fe::Hasher h;
-  h.add(std::string(kMeshReadVersion));
+  h.add(std::string(mesh::kReaderVersion));
   h.add_bytes(bytes.data(), bytes.size());
   h.add(options.sectors);
   h.add(options.match_tolerance);
