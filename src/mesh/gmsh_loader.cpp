@@ -1,6 +1,5 @@
 // The program's side of the gmsh module (mesh/gmsh_module.hpp): finds, loads and forwards.
 #include <dlfcn.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <mutex>
