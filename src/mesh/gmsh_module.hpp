@@ -38,7 +38,7 @@ inline constexpr const char* kGmshApiSymbol = "shroudsim_gmsh_api";
 
 /// The loaded module's table (loads it on the first call; thread-safe).
 const GmshApi& gmsh_api();
-/// The files the loader tries, in order (for messages and tests).
+/// The files the loader tries, in the order above (its error message lists them).
 std::vector<std::filesystem::path> gmsh_module_candidates();
 /// The module file loaded in this process (empty: not loaded, no gmsh was needed yet).
 std::filesystem::path gmsh_module_path();
