@@ -9,6 +9,7 @@ timed with each thread count T (default 1 and 2; T threads in every layer: shrou
 workers, OpenBLAS, CalculiX's solver):
   - `shroudsim modes CASE --threads T` (assembly, cyclic reduction, M modes of every harmonic
     index, modes.csv, modes.vtu, the plot), from the mesh just made, with an empty modal cache
+    (and again with --no-plots: the result files only, as CalculiX writes them)
     (the case is copied into the work folder, whose modal cache entries are removed before
     each run; the mesh as read, cached by `shroudsim mesh`, is read back without gmsh);
   - `ccx` (CalculiX) on the same mesh: C3D10 elements, the hub clamped, the cyclic faces tied
@@ -167,7 +168,7 @@ def main(argv):
             found = [f for f in os.listdir(os.path.join(work, "meshes")) if f.endswith(".msh")]
             msh = os.path.join(work, "meshes", found[0])
         dofs = write_ccx_input(msh, os.path.join(work, "sector.inp"), sectors, a.modes, material)
-        ours, theirs, stages = {}, {}, {}
+        ours, bare, theirs, stages = {}, {}, {}, {}
         for t in a.threads:
             # T threads in every layer: shroudsim's workers and the BLAS (OpenBLAS otherwise
             # starts one thread per core whatever --threads says), CalculiX's solver threads.
@@ -189,6 +190,12 @@ def main(argv):
                 print(f"bench_modal_ccx: the modal stage was reused from a cache at {size}", file=sys.stderr)
                 return 1
             stages[t] = {st["name"]: st["seconds"] for st in run["stages"]}
+            for entry in glob.glob(os.path.join(work, ".cache", "modes-*")):
+                os.remove(entry)
+            t0 = time.perf_counter()
+            subprocess.run([binary, "modes", local_case, "--out", out + "-bare", "--quiet", "--threads", str(t),
+                            "--no-plots"] + sets, cwd=work, env=env, check=True)
+            bare[t] = time.perf_counter() - t0
             t0 = time.perf_counter()
             r = subprocess.run([a.ccx, "-i", "sector"], cwd=work, env=env, stdout=subprocess.DEVNULL,
                                stderr=subprocess.PIPE, text=True)
@@ -204,27 +211,33 @@ def main(argv):
             for f1, f2 in zip(sorted(fs), other):
                 worst = max(worst, abs(f1 - f2) / f2)
         compared = sum(min(len(fs), len(f_theirs.get(nd, []))) for nd, fs in f_ours.items())
-        rows.append((size, dofs, ours, theirs, stages, worst, compared))
+        rows.append((size, dofs, ours, bare, theirs, stages, worst, compared))
         print(f"mesh_size {size:g}: {dofs} DOFs, shroudsim " +
-              ", ".join(f"{ours[t]:.1f} s ({t} thr.)" for t in a.threads) + "; ccx " +
+              ", ".join(f"{ours[t]:.1f} s ({t} thr.)" for t in a.threads) + " (--no-plots " +
+              ", ".join(f"{bare[t]:.1f} s" for t in a.threads) + "); ccx " +
               ", ".join(f"{theirs[t]:.1f} s ({t} thr.)" for t in a.threads) +
               f"; max rel. freq. diff. {worst:.2e} over {compared} modes", file=sys.stderr, flush=True)
     print(f"modes per nodal diameter: {a.modes}, Nb = {sectors}, case {os.path.basename(case)}")
     head = "| mesh_size | DOFs | " + " | ".join(f"shroudsim {t} thr. (s)" for t in a.threads) + " | " + \
+        " | ".join(f"--no-plots {t} thr. (s)" for t in a.threads) + " | " + \
         " | ".join(f"ccx {t} thr. (s)" for t in a.threads) + " | " + \
-        " | ".join(f"ratio at {t} thr." for t in a.threads) + " | best / best | max rel. freq. diff. (modes) |"
+        " | ".join(f"ratio at {t} thr." for t in a.threads) + \
+        " | best / best | best / best, --no-plots | max rel. freq. diff. (modes) |"
     print(head)
     print("|" + " --- |" * (head.count("|") - 1))
-    for size, dofs, ours, theirs, stages, worst, n in rows:
+    for size, dofs, ours, bare, theirs, stages, worst, n in rows:
         best = min(theirs.values()) / min(ours.values())
+        best_bare = min(theirs.values()) / min(bare.values())
         print(f"| {size:g} | {dofs:,} | " + " | ".join(f"{ours[t]:.1f}" for t in a.threads) + " | " +
+              " | ".join(f"{bare[t]:.1f}" for t in a.threads) + " | " +
               " | ".join(f"{theirs[t]:.1f}" for t in a.threads) + " | " +
-              " | ".join(f"{theirs[t] / ours[t]:.1f}x" for t in a.threads) + f" | {best:.1f}x | {worst:.2e} ({n}) |")
+              " | ".join(f"{theirs[t] / ours[t]:.1f}x" for t in a.threads) +
+              f" | {best:.1f}x | {best_bare:.1f}x | {worst:.2e} ({n}) |")
     print()
     print("Where shroudsim's time goes (run.json stages, s; the rest: start-up, output files, the plot):")
     print("| mesh_size | threads | mesh (read) | assembly | modes | rest |")
     print("| --- | --- | --- | --- | --- | --- |")
-    for size, dofs, ours, theirs, stages, worst, n in rows:
+    for size, dofs, ours, bare, theirs, stages, worst, n in rows:
         for t in a.threads:
             st = stages[t]
             known = sum(st.get(k, 0.0) for k in ("mesh", "assembly", "modes"))

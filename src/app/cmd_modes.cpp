@@ -136,6 +136,12 @@ EarlyPlotter::~EarlyPlotter() { g_plotter.cancel(); }
 
 void draw_plots(Context& ctx) {
   if (!ctx.plots) return;  // study points: the study plots once at the end
+  if (ctx.no_plots) {
+    auto& section = ctx.report.section("plots");
+    section["drawn"] = false;
+    section["reason"] = "--no-plots";
+    return;
+  }
   const fs::path script = plot_script();
   const std::string& python = kPython;
   auto skipped = [&]() {

@@ -11,7 +11,7 @@
 //   K_h = T_h^H K T_h = A + exp(i h alpha) B + exp(-i h alpha) B^T,
 //   A = P^T K P + G^T K G,   B = P^T K G      (the same for M),
 // Hermitian, and real for h = 0 and h = Nb/2. A and B are formed once, so every harmonic
-// index costs one sparse sum. K_{Nb-h} = conj(K_h), T_{Nb-h} = conj(T_h).
+// index costs one pass over the entries. K_{Nb-h} = conj(K_h), T_{Nb-h} = conj(T_h).
 //
 // Usage:
 //   fe::Assembler assembler(mesh);
@@ -101,8 +101,9 @@ class CyclicSector {
   int sectors_ = 1;
   Eigen::Index n_full_ = 0;
   std::vector<int> reduced_to_full_, clamped_dofs_;
-  linalg::SparseMatrixD P_, G_;  // n_full x n_reduced
-  linalg::SparseMatrixD KA_, KB_, MA_, MB_;
+  linalg::SparseMatrixD P_, G_;                          // n_full x n_reduced
+  linalg::SparseMatrixD KA_, KB_, MA_, MB_, KBt_, MBt_;  // compressed; KBt_ = KB_^T, MBt_ = MB_^T
+  std::vector<int> K_outer_, M_outer_;                   // column starts of KA_ + KB_ + KBt_, MA_ + ...
   std::vector<InterfaceSpring> springs_;
   /// Y_h^H diag(k) Y_h on the reduced DOFs (empty matrix without springs).
   linalg::SparseMatrixC interface_stiffness(int h) const;

@@ -73,4 +73,31 @@ SerialBlasScope::~SerialBlasScope() {
   if (--serial_depth == 0 && serial_saved > 0) set_blas_threads(serial_saved);
 }
 
+namespace {
+// The OpenMP runtime's entry points, looked up rather than linked: the runtime is whatever
+// CHOLMOD loaded (libgomp for Debian's), and a program without one needs no scope.
+struct OpenMPLevels {
+  using Set = void (*)(int);
+  using Get = int (*)();
+  Set set = reinterpret_cast<Set>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  Get get = reinterpret_cast<Get>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+  bool usable() const { return set && get; }
+};
+const OpenMPLevels& openmp_levels() {
+  static const OpenMPLevels levels;
+  return levels;
+}
+}  // namespace
+
+SerialOpenMPScope::SerialOpenMPScope() {
+  const auto& omp = openmp_levels();
+  if (!omp.usable()) return;
+  saved_ = omp.get();
+  omp.set(0);
+}
+
+SerialOpenMPScope::~SerialOpenMPScope() {
+  if (saved_ >= 0) openmp_levels().set(saved_);
+}
+
 }  // namespace shroudsim::linalg

@@ -38,4 +38,22 @@ class SerialBlasScope {
   SerialBlasScope& operator=(const SerialBlasScope&) = delete;
 };
 
+/// While alive, OpenMP parallel regions started on the calling thread run on that thread
+/// alone (max-active-levels 0; restored on destruction). For parallel workers that call a
+/// library threaded with OpenMP: CHOLMOD's supernodal factorization opens a team of its own
+/// fixed size for each large supernode, whatever OMP_NUM_THREADS says, so 2 workers on 2
+/// cores ran 6 threads and switched context 24,000 times in a 1.6 s `modes` run
+/// (docs/BENCHMARKS.md, "OpenMP teams inside the workers"). A no-op when no OpenMP runtime
+/// is loaded. One per thread; not to be moved across threads.
+class SerialOpenMPScope {
+ public:
+  SerialOpenMPScope();
+  ~SerialOpenMPScope();
+  SerialOpenMPScope(const SerialOpenMPScope&) = delete;
+  SerialOpenMPScope& operator=(const SerialOpenMPScope&) = delete;
+
+ private:
+  int saved_ = -1;  ///< the thread's max-active-levels before, -1: nothing to restore
+};
+
 }  // namespace shroudsim::linalg

@@ -7,12 +7,12 @@
 //
 // Each index runs once, on one of `workers` threads (the calling thread included), taken in
 // increasing order. The BLAS runs on one thread meanwhile (linalg::SerialBlasScope), whatever
-// the number of workers: OpenBLAS's own threads on top of the workers oversubscribe the cores,
-// and a job's round-off must not depend on the worker count (a factorization with a threaded
-// BLAS under one worker gave other modes, to round-off, than under two: --threads 1 and 2
-// then traced different curves on the same sector; docs/continuation.md, "Determinism"). A
-// job should catch its own exceptions; one that escapes is rethrown after all workers have
-// finished (the first one only).
+// the number of workers, and with two or more workers each one's OpenMP regions (CHOLMOD's)
+// run on its own thread (linalg::SerialOpenMPScope): OpenBLAS's own threads on top of the workers oversubscribe the
+// cores, and a job's round-off must not depend on the worker count (a factorization with a threaded BLAS under one
+// worker gave other modes, to round-off, than under two: --threads 1 and 2 then traced different curves on the same
+// sector; docs/continuation.md, "Determinism"). A job should catch its own exceptions; one that escapes is rethrown
+// after all workers have finished (the first one only).
 #include <algorithm>
 #include <atomic>
 #include <exception>
@@ -37,6 +37,10 @@ void parallel_for(int jobs, int workers, Job&& job) {
   std::mutex lock;
   std::exception_ptr failure;
   auto work = [&] {
+    // Each worker's OpenMP regions on its own thread (linalg::SerialOpenMPScope), for the
+    // same reason as the serial BLAS: the workers already fill the cores.
+    std::optional<linalg::SerialOpenMPScope> serial_openmp;
+    if (workers > 1) serial_openmp.emplace();
     for (int i; (i = next++) < jobs;) {
       try {
         job(i);

@@ -38,6 +38,7 @@ struct Context {
   int threads = 0;                     ///< 0: all cores
   std::vector<std::string> overrides;  ///< the command line's --set KEY=VALUE, in order
   bool plots = true;                   ///< draw plots after a command (off for study points)
+  bool no_plots = false;               ///< `--no-plots`: no plotting process, no plots (run.json plots.reason)
   bool convergence = false;            ///< `study --convergence`: the accuracy/speed trade
   bool resume = false;                 ///< `study --resume`: reuse the finished points in out_dir
   /// (frequency [Hz], amplitude [m]) of the forced response cmd_frf traced (as in frf.csv).

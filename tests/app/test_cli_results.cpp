@@ -207,6 +207,23 @@ TEST(CliResults, AnUnchangedMeshIsReadBackWithoutGmsh) {
   EXPECT_EQ(slurp(s.dir() / "b" / "modes.csv"), slurp(s.dir() / "a" / "modes.csv"));
 }
 
+// --no-plots: the same result files, no PNG, no plotting process, and run.json says why.
+TEST(CliResults, NoPlotsWritesTheSameResultsWithoutPictures) {
+  Scratch s("results_no_plots");
+  s.write("c.toml", kQuickCase);
+  ASSERT_EQ(s.run("modes c.toml --out a --quiet").status, 0);
+  ASSERT_EQ(s.run("modes c.toml --out b --quiet --no-plots").status, 0);
+  EXPECT_EQ(slurp(s.dir() / "b" / "modes.csv"), slurp(s.dir() / "a" / "modes.csv"));
+  EXPECT_TRUE(fs::exists(s.dir() / "b" / "modes.vtu"));
+  for (const auto& e : fs::directory_iterator(s.dir() / "b")) EXPECT_NE(e.path().extension(), ".png") << e.path();
+  const std::string run = slurp(s.dir() / "b" / "run.json");
+  EXPECT_NE(run.find("\"reason\": \"--no-plots\""), std::string::npos) << run;
+  EXPECT_NE(run.find("\"drawn\": false"), std::string::npos) << run;
+  // With plots, the run that drew them says so (or that matplotlib is missing: then no reason).
+  const std::string drew = slurp(s.dir() / "a" / "run.json");
+  EXPECT_EQ(drew.find("--no-plots"), std::string::npos) << drew;
+}
+
 const char* kLumped = R"(name = "lumped"
 [structure]
 type = "lumped"

@@ -1,4 +1,5 @@
 // linalg::parallel_for: every job, once; the BLAS on one thread whatever the worker count.
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCore>
@@ -35,6 +36,28 @@ TEST(ParallelFor, RunsItsJobsOnAOneThreadBlasWhateverTheWorkerCount) {
     EXPECT_EQ(set_blas_threads(2), outside) << "restored after the jobs";
   }
   set_blas_threads(before);
+}
+
+// With two or more workers, OpenMP regions a job opens (CHOLMOD's supernodal factorization opens
+// teams of a fixed size) run on the job's thread alone, and the setting is the thread's own:
+// the calling thread gets back what it had, and one worker does not change another's.
+TEST(ParallelFor, RunsOpenMPRegionsOfItsJobsOnTheirOwnThreadWithTwoOrMoreWorkers) {
+  using Get = int (*)();
+  const auto get = reinterpret_cast<Get>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+  if (!get) GTEST_SKIP() << "no OpenMP runtime loaded";
+  const int outside = get();
+  ASSERT_GT(outside, 0) << "nested regions allowed outside the jobs";
+  for (int workers : {2, 3}) {
+    std::vector<std::atomic<int>> seen(6);
+    for (auto& v : seen) v = -1;
+    parallel_for(6, workers, [&](int i) { seen[static_cast<std::size_t>(i)] = get(); });
+    for (const auto& v : seen) EXPECT_EQ(v.load(), 0) << workers << " workers";
+    EXPECT_EQ(get(), outside) << "restored on the calling thread";
+  }
+  // One worker: the caller's own setting (its regions may use the cores the pool leaves free).
+  std::atomic<int> one{-1};
+  parallel_for(1, 1, [&](int) { one = get(); });
+  EXPECT_EQ(one.load(), outside);
 }
 
 // Factorizations on parallel workers are those of one thread to the last bit. CHOLMOD's ordering
