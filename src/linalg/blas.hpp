@@ -43,8 +43,9 @@ class SerialBlasScope {
 /// library threaded with OpenMP: CHOLMOD's supernodal factorization opens a team of its own
 /// fixed size for each large supernode, whatever OMP_NUM_THREADS says, so 2 workers on 2
 /// cores ran 6 threads and switched context 24,000 times in a 1.6 s `modes` run
-/// (docs/BENCHMARKS.md, "OpenMP teams inside the workers"). A no-op when no OpenMP runtime
-/// is loaded. One per thread; not to be moved across threads.
+/// (BENCHMARKS.md, "The reduction in one pass, the mass product by blocks, OpenMP inside the
+/// workers, ..."). A no-op when no OpenMP runtime is loaded. One per thread; not to be moved
+/// across threads.
 class SerialOpenMPScope {
  public:
   SerialOpenMPScope();

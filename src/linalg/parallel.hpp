@@ -7,12 +7,14 @@
 //
 // Each index runs once, on one of `workers` threads (the calling thread included), taken in
 // increasing order. The BLAS runs on one thread meanwhile (linalg::SerialBlasScope), whatever
-// the number of workers, and with two or more workers each one's OpenMP regions (CHOLMOD's)
-// run on its own thread (linalg::SerialOpenMPScope): OpenBLAS's own threads on top of the workers oversubscribe the
-// cores, and a job's round-off must not depend on the worker count (a factorization with a threaded BLAS under one
-// worker gave other modes, to round-off, than under two: --threads 1 and 2 then traced different curves on the same
-// sector; docs/continuation.md, "Determinism"). A job should catch its own exceptions; one that escapes is rethrown
-// after all workers have finished (the first one only).
+// the number of workers: OpenBLAS's own threads on top of the workers oversubscribe the
+// cores, and a job's round-off must not depend on the worker count (a factorization with a
+// threaded BLAS under one worker gave other modes, to round-off, than under two: --threads 1
+// and 2 then traced different curves on the same sector; docs/continuation.md,
+// "Determinism"). With two or more workers, each one's OpenMP regions (CHOLMOD's
+// factorization) also run on its own thread (linalg::SerialOpenMPScope). A job should catch
+// its own exceptions; one that escapes is rethrown after all workers have finished (the
+// first one only).
 #include <algorithm>
 #include <atomic>
 #include <exception>

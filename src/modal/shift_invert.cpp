@@ -40,8 +40,10 @@ struct Shifted {
 // (Eigen's sparse-times-dense product streams the whole matrix for every column, and at 40k
 // DOFs that product was the largest part of a Lanczos step after the half solves). Each
 // result entry sums its terms in the order Eigen's product does (by column of M), and a
-// complex term is m y written out in real arithmetic, so the result has the same bits for
-// finite values; libgcc's NaN-checking complex multiply is not called.
+// complex term is m y written out in real arithmetic (libgcc's NaN-checking complex multiply
+// is not called). Not the same bits as Eigen's optimised complex product (the same loop at
+// -O0 is): the modes change in their last digits (BENCHMARKS.md, "The reduction in one
+// pass, the mass product by blocks, ...").
 template <typename S>
 Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> mass_product(
     const linalg::SparseMatrix<S>& M, const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>& Y) {
