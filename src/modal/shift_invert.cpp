@@ -41,8 +41,8 @@ struct Shifted {
 // DOFs that product was the largest part of a Lanczos step after the half solves). Each
 // result entry sums its terms in the order Eigen's product does (by column of M), and a
 // complex term is m y written out in real arithmetic (libgcc's NaN-checking complex multiply
-// is not called). Not the same bits as Eigen's optimised complex product (the same loop at
-// -O0 is): the modes change in their last digits (BENCHMARKS.md, "The reduction in one
+// is not called). Compiled with -O3 it does not give the bits of Eigen's product (at -O0
+// the two agree to the last bit): the modes change in their last digits (BENCHMARKS.md, "The reduction in one
 // pass, the mass product by blocks, ...").
 template <typename S>
 Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> mass_product(
