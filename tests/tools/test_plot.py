@@ -33,6 +33,20 @@ class WaitingPlotter(unittest.TestCase):
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertTrue(os.path.exists(os.path.join(d, "nd_map.png")))
 
+    def test_nd_map_has_a_second_panel_only_beyond_ten_families(self):
+        # The PNG's width (bytes 16-19 of its header) tells one panel (7.5 in at 120 dpi) from two (13 in).
+        for families, width in ((2, 900), (10, 900), (12, 1560)):
+            with tempfile.TemporaryDirectory() as d:
+                with open(os.path.join(d, "modes.csv"), "w") as f:
+                    f.write("harmonic_index,nodal_diameter,mode,frequency_hz\n")
+                    for h in (0, 1):
+                        for m in range(1, families + 1):
+                            f.write(f"{h},{h},{m},{100.0 * m + h}\n")
+                r = subprocess.run([sys.executable, PLOT, d], capture_output=True, text=True, timeout=120)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                with open(os.path.join(d, "nd_map.png"), "rb") as f:
+                    self.assertEqual(int.from_bytes(f.read(24)[16:20], "big"), width, families)
+
     def test_empty_stdin_draws_nothing(self):
         with tempfile.TemporaryDirectory() as d:
             with open(os.path.join(d, "modes.csv"), "w") as f:

@@ -47,8 +47,11 @@ def plot_nd_map(result_dir):
     fam = _families(read_csv(os.path.join(result_dir, "modes.csv")))
     nds = sorted(fam)
     n_modes = max(len(v) for v in fam.values())
-    fig, axes = plt.subplots(1, 2, figsize=(13, 6))
-    for ax, count in zip(axes, (n_modes, min(10, n_modes))):
+    # All families, and beside them the lowest 10 when there are more (with 10 or fewer the
+    # second panel would be the first again).
+    counts = (n_modes, 10) if n_modes > 10 else (n_modes,)
+    fig, axes = plt.subplots(1, len(counts), figsize=(13 if len(counts) == 2 else 7.5, 6), squeeze=False)
+    for ax, count in zip(axes[0], counts):
         for r in range(count):
             xs = [nd for nd in nds if r < len(fam[nd])]
             ys = [fam[nd][r] for nd in xs]
