@@ -23,6 +23,7 @@ has its own element and its own cyclic constraint). Needs /usr/bin/python3 with 
 """
 import argparse
 import glob
+import json
 import math
 import os
 import re
@@ -174,28 +175,30 @@ def main(argv):
             # starts one thread per core whatever --threads says), CalculiX's solver threads.
             env = dict(os.environ, OMP_NUM_THREADS=str(t), OPENBLAS_NUM_THREADS=str(t),
                        CCX_NPROC_EQUATION_SOLVER=str(t), CCX_NPROC_STIFFNESS=str(t))
-            # The modal entries only: the mesh entry the `mesh` command left (the mesh as read and
-            # checked, .cache/mesh-*.bin) stays, as in a user's second command on a mesh.
-            for entry in glob.glob(os.path.join(work, ".cache", "modes-*")):
-                os.remove(entry)
-            out = os.path.join(work, f"modes{t}")
-            t0 = time.perf_counter()
-            subprocess.run([binary, "modes", local_case, "--out", out, "--quiet", "--threads", str(t)] + sets,
-                           cwd=work, env=env, check=True)
-            ours[t] = time.perf_counter() - t0
-            with open(os.path.join(out, "run.json")) as f:
-                import json
-                run = json.load(f)
-            if any(st["name"] == "modes" and st["reused"] for st in run["stages"]):
+            def timed_modes(out, extra):
+                """`shroudsim modes` from an empty modal cache: (wall seconds, run.json stage times), or
+                None when the modal stage was reused all the same. The modal entries only are removed:
+                the mesh entry the `mesh` command left (the mesh as read and checked,
+                .cache/mesh-*.bin) stays, as in a user's second command on a mesh."""
+                for entry in glob.glob(os.path.join(work, ".cache", "modes-*")):
+                    os.remove(entry)
+                t0 = time.perf_counter()
+                subprocess.run([binary, "modes", local_case, "--out", out, "--quiet", "--threads", str(t)] + extra +
+                               sets, cwd=work, env=env, check=True)
+                seconds = time.perf_counter() - t0
+                with open(os.path.join(out, "run.json")) as f:
+                    run = json.load(f)
+                if any(st["name"] == "modes" and st["reused"] for st in run["stages"]):
+                    return None
+                return seconds, {st["name"]: st["seconds"] for st in run["stages"]}
+
+            with_plot = timed_modes(os.path.join(work, f"modes{t}"), [])
+            without = timed_modes(os.path.join(work, f"modes{t}-bare"), ["--no-plots"])
+            if with_plot is None or without is None:
                 print(f"bench_modal_ccx: the modal stage was reused from a cache at {size}", file=sys.stderr)
                 return 1
-            stages[t] = {st["name"]: st["seconds"] for st in run["stages"]}
-            for entry in glob.glob(os.path.join(work, ".cache", "modes-*")):
-                os.remove(entry)
-            t0 = time.perf_counter()
-            subprocess.run([binary, "modes", local_case, "--out", out + "-bare", "--quiet", "--threads", str(t),
-                            "--no-plots"] + sets, cwd=work, env=env, check=True)
-            bare[t] = time.perf_counter() - t0
+            ours[t], stages[t] = with_plot
+            bare[t] = without[0]
             t0 = time.perf_counter()
             r = subprocess.run([a.ccx, "-i", "sector"], cwd=work, env=env, stdout=subprocess.DEVNULL,
                                stderr=subprocess.PIPE, text=True)

@@ -42,8 +42,8 @@ struct Shifted {
 // result entry sums its terms in the order Eigen's product does (by column of M), and a
 // complex term is m y written out in real arithmetic (libgcc's NaN-checking complex multiply
 // is not called). Compiled with -O3 it does not give the bits of Eigen's product (at -O0
-// the two agree to the last bit): the modes change in their last digits (BENCHMARKS.md, "The reduction in one
-// pass, the mass product by blocks, ...").
+// the two agree to the last bit): the modes change in their last digits (BENCHMARKS.md,
+// "The reduction in one pass, the mass product by blocks, ...").
 template <typename S>
 Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> mass_product(
     const linalg::SparseMatrix<S>& M, const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>& Y) {
