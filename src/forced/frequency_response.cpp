@@ -194,11 +194,16 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
   if (continuation::newton_fixed(equations, start, f, ao) >= 0) return start;
   if (eo.n_harmonics > 1) {
     // Harmonic stepping: solve the start with H = 1, then raise H one harmonic at a time,
-    // each new harmonic starting at zero (higher harmonics are small corrections).
+    // each new harmonic starting at zero (higher harmonics are small corrections). A level
+    // that Newton does not reach from the one below is reached by the excitation homotopy at
+    // that level: its unknowns are h / H of the case's, so a path of the same length costs a
+    // fraction of the homotopy at H (docs/continuation.md, "Start"). Level H itself is left
+    // to the homotopy below, which is the same computation.
     say(info, "frf: no start at " + shortest(f) + " Hz from the stuck or the free state" + after() +
                   "; trying harmonic stepping");
     Eigen::VectorXd prev;
     int prev_h = 0;
+    std::vector<std::string> by_homotopy;  // the levels reached by the excitation homotopy
     for (int h = 1; h <= eo.n_harmonics; ++h) {
       hbm::ContactEvaluatorOptions step_options = eo;
       step_options.n_harmonics = h;
@@ -209,10 +214,6 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
       Eigen::VectorXd w;
       if (h == 1) {
         w = step_equations.stuck_solution(f);
-        if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
-          if (solve_by_excitation_homotopy(step_equations, f, so, w).status != continuation::BranchStatus::kReachedEnd)
-            break;
-        }
       } else {
         w = Eigen::VectorXd::Zero(step_equations.size());
         const auto& lo = step_evaluator.pair_layout();
@@ -224,13 +225,26 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
                 if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
                 w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
               }
-        if (continuation::newton_fixed(step_equations, w, f, so) < 0) break;
+      }
+      if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
+        if (h == eo.n_harmonics) break;
+        const continuation::Branch b = solve_by_excitation_homotopy(step_equations, f, so, w);
+        if (b.status != continuation::BranchStatus::kReachedEnd) break;
+        say(info, "frf: H = " + std::to_string(h) + " at " + shortest(f) +
+                      " Hz by continuation in the excitation level (" + std::to_string(b.points.size()) + " points)" +
+                      after());
+        by_homotopy.push_back(std::to_string(h));
       }
       prev = w;
       prev_h = h;
     }
     if (prev_h == eo.n_harmonics) {
       how = "harmonic stepping";
+      if (!by_homotopy.empty()) {
+        std::string levels;
+        for (const std::string& l : by_homotopy) levels += (levels.empty() ? "" : ", ") + l;
+        how += " (the excitation homotopy at H = " + levels + ")";
+      }
       say(info, "frf: start point at " + shortest(f) + " Hz by harmonic stepping (H = 1 .. " +
                     std::to_string(eo.n_harmonics) + ")" + after());
       return prev;
@@ -246,7 +260,9 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
         " Hz: Newton failed from the stuck-contact state and the continuation in the excitation level stopped: " +
         h.message);
   say(info, "frf: start point found by continuation in the excitation level (" + std::to_string(h.points.size()) +
-                " points)" + after());
+                " points, " + std::to_string(h.newton_iterations) + " Newton iterations, " +
+                std::to_string(h.rejected_steps) + " rejected steps of which " + std::to_string(h.rejected_turns) +
+                " turned too far, " + std::to_string(h.kinks_crossed) + " corners crossed)" + after());
   return start;
 }
 
