@@ -11,6 +11,7 @@
 #include <set>
 
 #include "../common/coarse_sector.hpp"
+#include "../common/sector_contacts.hpp"
 #include "cyclic/cyclic_sector.hpp"
 #include "frf/sector.hpp"
 #include "modal/harmonic.hpp"
@@ -464,6 +465,74 @@ TEST(SectorShapes, KeptStaticSolutionsGiveTheFactorsDisplacements) {
     EXPECT_LT((kept[0][n] - one[0][n]).norm(), kRoundOff * one[0][n].norm()) << "n " << n;
     EXPECT_TRUE(one[0][n] == two[0][n]) << "n " << n;  // bitwise: each index's arithmetic on any thread count
   }
+}
+
+}  // namespace
+}  // namespace shroudsim::frf
+
+#include "forced/frequency_response.hpp"
+
+namespace shroudsim::frf {
+namespace {
+
+// The start search's harmonic stepping reaches a level that Newton does not reach from the
+// level below by the excitation homotopy at that level (docs/continuation.md, "Start"). On the
+// coarse sector with all 10 shroud pairs (full3d, H = 5) that happens near the first family's
+// resonance, at one level or several. Each such start is checked against an independent route
+// to it: the excitation homotopy with all five harmonics from the preload-only state. Both end
+// at the corrector's tolerance (1e-8 of the x unit per residual), so they agree to about that
+// relative to the solution; kSameSolution allows a factor 100 for the equations' conditioning.
+TEST(SectorForced, AStartThroughTheHomotopyAtALowerLevelIsTheFullHomotopysSolution) {
+  constexpr double kSameSolution = 1e-6;
+  const Fixture f;
+  std::vector<SectorContactPair> pairs;
+  std::vector<contact::PairParameters> params;
+  for (const auto& [low, high] : f.mesh.shroud_pairs) {
+    pairs.push_back(testing_support::circumferential_pair(f.mesh, low, high));
+    contact::PairParameters pp;
+    pp.tangential_stiffness = 2e5;
+    pp.normal_stiffness = 2e5;
+    pp.normal_preload = 0.02;
+    params.push_back(pp);
+  }
+  SectorForcing forcing = testing_support::test_forcing(f.mesh, true);
+  forcing.damping_ratio = 0.01;
+  modal::ModalOptions mo;
+  mo.modes = 15;
+  std::map<int, modal::ModalBasis> bases;
+  for (int h : {1, 2, 3, 4, 5}) bases[h] = modal::solve_harmonic(*f.sector, h, mo).basis;
+  forced::ForcedModel model;
+  model.linear = std::make_unique<SectorLinearPart>(
+      *f.sector, bases, [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); }, pairs, forcing, 5);
+  model.pairs = params;
+  hbm::ContactEvaluatorOptions o;
+  o.n_harmonics = 5;
+  o.n_time_samples = 128;
+  o.law.model = contact::Model::full3d;
+  o.threads = 1;
+  hbm::ContactEvaluator ev(o, params);
+  forced::ReducedEquations eq(*model.linear, ev);
+  const double f1 = bases.at(1).omega[0] / (2 * std::numbers::pi);
+  forced::FrequencyResponseSettings s;
+  s.frequency_start_hz = 0.7 * f1;
+  s.frequency_end_hz = 1.3 * f1;
+  const continuation::ArclengthOptions ao = forced::arclength_options(s, model, eq);
+  int checked = 0, several_levels = 0;
+  for (double ratio : {0.98, 1.0, 1.02, 1.04, 1.06}) {  // of the first family's free frequency
+    const double fr = ratio * f1;
+    std::string how;
+    const Eigen::VectorXd w = forced::find_start(model, o, eq, ao, fr, how);
+    const auto at = how.find("the excitation homotopy at H = ");
+    if (at == std::string::npos) continue;
+    Eigen::VectorXd reference;
+    const auto b = forced::solve_by_excitation_homotopy(eq, fr, ao, reference);
+    ASSERT_EQ(b.status, continuation::BranchStatus::kReachedEnd) << fr << " Hz: " << b.message;
+    EXPECT_LT((w - reference).norm(), kSameSolution * reference.norm()) << fr << " Hz, " << how;
+    ++checked;
+    if (how.find(',', at) != std::string::npos) ++several_levels;
+  }
+  EXPECT_GE(checked, 2);
+  EXPECT_GE(several_levels, 1);
 }
 
 }  // namespace
