@@ -67,10 +67,12 @@ continuation::ArclengthOptions arclength_options(const FrequencyResponseSettings
 
 /// A solution of `equations` at frequency f: Newton from the stuck-contact solution; where it
 /// fails (Newton cycling between contact states), from the free response, then harmonic
-/// stepping (H = 1, then one harmonic at a time, each new one from zero), then continuation in
-/// the excitation level from the preload-only state. When all of these fail at f, the same
-/// search a little way off (f (1 +- 0.002, 0.005, 0.01)), then Newton at fixed frequencies
-/// back to f. `how` names the method that worked. Throws NumericalError when none does.
+/// stepping (H = 1, then one harmonic at a time, each new one from zero; a level below H that
+/// Newton does not reach is reached by continuation in the excitation level with that many
+/// harmonics), then continuation in the excitation level from the preload-only state. When
+/// all of these fail at f, the same search a little way off (f (1 +- 0.002, 0.005, 0.01)),
+/// then Newton at fixed frequencies back to f. `how` names the method that worked. Throws
+/// NumericalError when none does.
 Eigen::VectorXd find_start(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
                            ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
                            std::string& how);
