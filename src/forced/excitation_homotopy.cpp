@@ -49,7 +49,8 @@ class ExcitationHomotopy : public continuation::ParametricResidual {
 }  // namespace
 
 continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, double frequency_hz,
-                                                  const continuation::ArclengthOptions& options, Eigen::VectorXd& w) {
+                                                  const continuation::ArclengthOptions& options, Eigen::VectorXd& w,
+                                                  const HomotopyStart* from) {
   ExcitationHomotopy homotopy(equations, frequency_hz);
   homotopy.lin_ = equations.linear_motion(frequency_hz);
   // From no excitation to the equations' own excitation scale (1 unless a caller scaled it).
@@ -73,7 +74,12 @@ continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, d
   const Eigen::VectorXd start = equations.stuck_solution(frequency_hz);
   const double extent = std::max((target * homotopy.lin_).norm(), (stuck_end - start).norm());
   if (std::isfinite(extent) && extent > 0) o.x_scale = Eigen::VectorXd::Constant(start.size(), extent / kPathUnits);
-  continuation::Branch b = continuation::trace(homotopy, start, o);
+  const bool resume = from != nullptr && from->scale > 0.0 && from->scale < 1.0;
+  if (resume) {
+    o.lambda_start = from->scale * target;
+    o.start_slack = o.lambda_start + target;  // still down to s = -target
+  }
+  continuation::Branch b = continuation::trace(homotopy, resume ? from->x : start, o);
   equations.set_excitation_scale(saved);
   if (b.status == continuation::BranchStatus::kReachedEnd) w = b.points.back().x;
   return b;

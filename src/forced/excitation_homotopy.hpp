@@ -17,12 +17,22 @@
 
 namespace shroudsim::forced {
 
+/// A solution of the equations at excitation scale `scale` (0 < scale < 1 of the target) that the
+/// homotopy may start from instead of the preload-only state: the part of the path below it is
+/// not traced again.
+struct HomotopyStart {
+  double scale = 0.0;
+  Eigen::VectorXd x;
+};
+
 /// The continuation in s at `frequency_hz` [Hz] with `options`' tolerance and corrector
 /// settings (the lambda range, the x unit, the steps and the point cap are set here; the x unit
 /// from the path's own extent, the larger of the free and the stuck motion at this frequency).
 /// Returns the branch; on BranchStatus::kReachedEnd, w (output only) holds the solution at
-/// s = 1. equations' excitation scale is restored before returning.
+/// s = 1. equations' excitation scale is restored before returning. With `from`, the path
+/// starts at from->scale (times the target) from from->x.
 continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, double frequency_hz,
-                                                  const continuation::ArclengthOptions& options, Eigen::VectorXd& w);
+                                                  const continuation::ArclengthOptions& options, Eigen::VectorXd& w,
+                                                  const HomotopyStart* from = nullptr);
 
 }  // namespace shroudsim::forced

@@ -171,6 +171,58 @@ void say(const Info& info, const std::string& s) {
   if (info) info(s);
 }
 
+// `v`, a solution with `from_h` harmonics, in the layout of `to` (more harmonics): the new
+// harmonics zero.
+Eigen::VectorXd with_more_harmonics(const Eigen::VectorXd& v, int from_h, const hbm::ContactEvaluator& to) {
+  const auto& lo = to.pair_layout();
+  const hbm::HarmonicLayout from(from_h, lo.n_directions());
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(to.n_pairs()) * lo.size());
+  for (int p = 0; p < to.n_pairs(); ++p)
+    for (int d = 0; d < lo.n_directions(); ++d)
+      for (int n = 0; n <= from_h; ++n)
+        for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
+          if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
+          w[p * lo.size() + lo.index(d, n, part)] = v[p * from.size() + from.index(d, n, part)];
+        }
+  return w;
+}
+
+// The excitation homotopy of a lower stepping level: its path's points (excitation scale,
+// solution) and its number of harmonics.
+struct LowerPath {
+  std::vector<std::pair<double, Eigen::VectorXd>> points;
+  int harmonics = 0;
+};
+
+// Where the excitation homotopy at a stepping level can start instead of the preload-only
+// state: the point of the lower level's path at the highest excitation scale from which Newton
+// at this level converges (the point padded with zero new harmonics). Found by bisection over
+// the path: Newton converges at low excitation, where the contact barely slips and the new
+// harmonics are small, and has just failed at s = 1. Returns scale 0 when no point serves.
+HomotopyStart resume_point(const LowerPath& lower, ReducedEquations& level, const hbm::ContactEvaluator& evaluator,
+                           double f, const continuation::ArclengthOptions& ao) {
+  HomotopyStart best;
+  const double saved = level.excitation_scale();
+  const double target = saved > 0.0 ? saved : 1.0;
+  int lo = 0, hi = static_cast<int>(lower.points.size()) - 1;
+  while (lo <= hi) {
+    const int mid = (lo + hi + 1) / 2;
+    const auto& [scale, x] = lower.points[static_cast<std::size_t>(mid)];
+    Eigen::VectorXd w = with_more_harmonics(x, lower.harmonics, evaluator);
+    level.set_excitation_scale(scale);
+    const bool ok = scale > 0.0 && scale < target && continuation::newton_fixed(level, w, f, ao) >= 0;
+    if (ok) {
+      best.scale = scale / target;
+      best.x = std::move(w);
+      lo = mid + 1;
+    } else {
+      hi = mid - 1;
+    }
+  }
+  level.set_excitation_scale(saved);
+  return best;
+}
+
 // The start search at one frequency (see find_start); throws NumericalError.
 Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
                               ReducedEquations& equations, const continuation::ArclengthOptions& ao, double f,
@@ -204,6 +256,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
     Eigen::VectorXd prev;
     int prev_h = 0;
     std::vector<std::string> by_homotopy;  // the levels reached by the excitation homotopy
+    LowerPath lower;                       // the path of the last of them
     for (int h = 1; h <= eo.n_harmonics; ++h) {
       hbm::ContactEvaluatorOptions step_options = eo;
       step_options.n_harmonics = h;
@@ -215,25 +268,27 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
       if (h == 1) {
         w = step_equations.stuck_solution(f);
       } else {
-        w = Eigen::VectorXd::Zero(step_equations.size());
-        const auto& lo = step_evaluator.pair_layout();
-        const hbm::HarmonicLayout prev_layout(prev_h, lo.n_directions());
-        for (int p = 0; p < step_evaluator.n_pairs(); ++p)
-          for (int d = 0; d < lo.n_directions(); ++d)
-            for (int n = 0; n <= prev_h; ++n)
-              for (auto part : {hbm::HarmonicLayout::Part::cosine, hbm::HarmonicLayout::Part::sine}) {
-                if (n == 0 && part == hbm::HarmonicLayout::Part::sine) continue;
-                w[p * lo.size() + lo.index(d, n, part)] = prev[p * prev_layout.size() + prev_layout.index(d, n, part)];
-              }
+        w = with_more_harmonics(prev, prev_h, step_evaluator);
       }
       if (continuation::newton_fixed(step_equations, w, f, so) < 0) {
         if (h == eo.n_harmonics) break;
-        const continuation::Branch b = solve_by_excitation_homotopy(step_equations, f, so, w);
+        // The part of the lower level's path where this level's Newton converges from it is
+        // not traced again (docs/continuation.md, "Start").
+        const HomotopyStart from = lower.points.empty() ? HomotopyStart{}
+                                                        : resume_point(lower, step_equations, step_evaluator, f, so);
+        const continuation::Branch b =
+            solve_by_excitation_homotopy(step_equations, f, so, w, from.scale > 0.0 ? &from : nullptr);
         if (b.status != continuation::BranchStatus::kReachedEnd) break;
         say(info, "frf: H = " + std::to_string(h) + " at " + shortest(f) +
-                      " Hz by continuation in the excitation level (" + std::to_string(b.points.size()) + " points)" +
-                      after());
+                      " Hz by continuation in the excitation level (" + std::to_string(b.points.size()) + " points" +
+                      (from.scale > 0.0 ? " from s = " + shortest(from.scale) +
+                                              " on the path of H = " + std::to_string(lower.harmonics)
+                                        : std::string()) +
+                      ")" + after());
         by_homotopy.push_back(std::to_string(h));
+        lower.points.clear();
+        for (const auto& pt : b.points) lower.points.emplace_back(pt.lambda, pt.x);
+        lower.harmonics = h;
       }
       prev = w;
       prev_h = h;
