@@ -262,6 +262,7 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
       step_options.n_harmonics = h;
       hbm::ContactEvaluator step_evaluator(step_options, model.pairs);
       ReducedEquations step_equations(*model.linear, step_evaluator);
+      step_equations.set_excitation_scale(equations.excitation_scale());  // nlmodes traces scaled ones
       continuation::ArclengthOptions so = ao;
       so.x_scale = Eigen::VectorXd::Constant(step_equations.size(), x_scale);
       Eigen::VectorXd w;

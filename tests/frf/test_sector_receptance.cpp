@@ -533,6 +533,17 @@ TEST(SectorForced, AStartThroughTheHomotopyAtALowerLevelIsTheFullHomotopysSoluti
   }
   EXPECT_GE(checked, 2);
   EXPECT_GE(several_levels, 1);
+  // The stepping solves the equations at their own excitation scale (nlmodes' comparison traces
+  // scaled excitations): at half the excitation the start is the half-excitation solution.
+  eq.set_excitation_scale(0.5);
+  const double fr = 1.02 * f1;
+  std::string how;
+  const Eigen::VectorXd w = forced::find_start(model, o, eq, ao, fr, how);
+  ASSERT_NE(how.find("harmonic stepping"), std::string::npos) << how;
+  Eigen::VectorXd reference;
+  ASSERT_EQ(forced::solve_by_excitation_homotopy(eq, fr, ao, reference).status,
+            continuation::BranchStatus::kReachedEnd);
+  EXPECT_LT((w - reference).norm(), kSameSolution * reference.norm()) << how;
 }
 
 }  // namespace
