@@ -74,9 +74,9 @@ continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, d
   const Eigen::VectorXd start = equations.stuck_solution(frequency_hz);
   const double extent = std::max((target * homotopy.lin_).norm(), (stuck_end - start).norm());
   if (std::isfinite(extent) && extent > 0) o.x_scale = Eigen::VectorXd::Constant(start.size(), extent / kPathUnits);
-  const bool resume = from != nullptr && from->scale > 0.0 && from->scale < 1.0;
+  const bool resume = from != nullptr && from->scale > 0.0 && from->scale < target;
   if (resume) {
-    o.lambda_start = from->scale * target;
+    o.lambda_start = from->scale;
     o.start_slack = o.lambda_start + target;  // still down to s = -target
   }
   continuation::Branch b = continuation::trace(homotopy, resume ? from->x : start, o);

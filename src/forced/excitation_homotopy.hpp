@@ -17,9 +17,9 @@
 
 namespace shroudsim::forced {
 
-/// A solution of the equations at excitation scale `scale` (0 < scale < 1 of the target) that the
-/// homotopy may start from instead of the preload-only state: the part of the path below it is
-/// not traced again.
+/// A solution of the equations at excitation scale `scale` (between 0 and the equations' own
+/// scale) that the homotopy may start from instead of the preload-only state: the part of the
+/// path below it is not traced again.
 struct HomotopyStart {
   double scale = 0.0;
   Eigen::VectorXd x;
@@ -30,7 +30,7 @@ struct HomotopyStart {
 /// from the path's own extent, the larger of the free and the stuck motion at this frequency).
 /// Returns the branch; on BranchStatus::kReachedEnd, w (output only) holds the solution at
 /// s = 1. equations' excitation scale is restored before returning. With `from`, the path
-/// starts at from->scale (times the target) from from->x.
+/// starts at from->scale from from->x.
 continuation::Branch solve_by_excitation_homotopy(ReducedEquations& equations, double frequency_hz,
                                                   const continuation::ArclengthOptions& options, Eigen::VectorXd& w,
                                                   const HomotopyStart* from = nullptr);

@@ -187,39 +187,32 @@ Eigen::VectorXd with_more_harmonics(const Eigen::VectorXd& v, int from_h, const 
   return w;
 }
 
-// The excitation homotopy of a lower stepping level: its path's points (excitation scale,
-// solution) and its number of harmonics.
-struct LowerPath {
-  std::vector<std::pair<double, Eigen::VectorXd>> points;
-  int harmonics = 0;
-};
-
 // Where the excitation homotopy at a stepping level can start instead of the preload-only
-// state: the point of the lower level's path at the highest excitation scale from which Newton
-// at this level converges (the point padded with zero new harmonics). Found by bisection over
-// the path: Newton converges at low excitation, where the contact barely slips and the new
-// harmonics are small, and has just failed at s = 1. Returns scale 0 when no point serves.
-HomotopyStart resume_point(const LowerPath& lower, ReducedEquations& level, const hbm::ContactEvaluator& evaluator,
-                           double f, const continuation::ArclengthOptions& ao) {
+// state: the point of a lower level's homotopy path (`lower`, with `lower_h` harmonics) at the
+// highest excitation scale from which Newton at this level converges (the point padded with
+// zero new harmonics). Found by bisection over the path: Newton converges at low excitation,
+// where the contact barely slips and the new harmonics are small, and has just failed at the
+// full one. Returns scale 0 when no point serves.
+HomotopyStart resume_point(const std::vector<continuation::BranchPoint>& lower, int lower_h, ReducedEquations& level,
+                           const hbm::ContactEvaluator& evaluator, double f, const continuation::ArclengthOptions& ao) {
   HomotopyStart best;
-  const double saved = level.excitation_scale();
-  const double target = saved > 0.0 ? saved : 1.0;
-  int lo = 0, hi = static_cast<int>(lower.points.size()) - 1;
+  const double full = level.excitation_scale();
+  int lo = 0, hi = static_cast<int>(lower.size()) - 1;
   while (lo <= hi) {
     const int mid = (lo + hi + 1) / 2;
-    const auto& [scale, x] = lower.points[static_cast<std::size_t>(mid)];
-    Eigen::VectorXd w = with_more_harmonics(x, lower.harmonics, evaluator);
-    level.set_excitation_scale(scale);
-    const bool ok = scale > 0.0 && scale < target && continuation::newton_fixed(level, w, f, ao) >= 0;
+    const continuation::BranchPoint& p = lower[static_cast<std::size_t>(mid)];
+    Eigen::VectorXd w = with_more_harmonics(p.x, lower_h, evaluator);
+    level.set_excitation_scale(p.lambda);
+    const bool ok = p.lambda > 0.0 && p.lambda < full && continuation::newton_fixed(level, w, f, ao) >= 0;
     if (ok) {
-      best.scale = scale / target;
+      best.scale = p.lambda;
       best.x = std::move(w);
       lo = mid + 1;
     } else {
       hi = mid - 1;
     }
   }
-  level.set_excitation_scale(saved);
+  level.set_excitation_scale(full);
   return best;
 }
 
@@ -255,8 +248,9 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
                   "; trying harmonic stepping");
     Eigen::VectorXd prev;
     int prev_h = 0;
-    std::vector<std::string> by_homotopy;  // the levels reached by the excitation homotopy
-    LowerPath lower;                       // the path of the last of them
+    std::string by_homotopy;     // the levels reached by the excitation homotopy ("2, 3")
+    continuation::Branch lower;  // the path of the last of them
+    int lower_h = 0;
     for (int h = 1; h <= eo.n_harmonics; ++h) {
       hbm::ContactEvaluatorOptions step_options = eo;
       step_options.n_harmonics = h;
@@ -275,32 +269,28 @@ Eigen::VectorXd find_start_at(const ForcedModel& model, const hbm::ContactEvalua
         if (h == eo.n_harmonics) break;
         // The part of the lower level's path where this level's Newton converges from it is
         // not traced again (docs/continuation.md, "Start").
-        const HomotopyStart from = lower.points.empty() ? HomotopyStart{}
-                                                        : resume_point(lower, step_equations, step_evaluator, f, so);
-        const continuation::Branch b =
+        const HomotopyStart from = lower.points.empty()
+                                       ? HomotopyStart{}
+                                       : resume_point(lower.points, lower_h, step_equations, step_evaluator, f, so);
+        continuation::Branch b =
             solve_by_excitation_homotopy(step_equations, f, so, w, from.scale > 0.0 ? &from : nullptr);
         if (b.status != continuation::BranchStatus::kReachedEnd) break;
         say(info, "frf: H = " + std::to_string(h) + " at " + shortest(f) +
                       " Hz by continuation in the excitation level (" + std::to_string(b.points.size()) + " points" +
-                      (from.scale > 0.0 ? " from s = " + shortest(from.scale) +
-                                              " on the path of H = " + std::to_string(lower.harmonics)
-                                        : std::string()) +
+                      (from.scale > 0.0
+                           ? " from s = " + shortest(from.scale) + " on the path of H = " + std::to_string(lower_h)
+                           : std::string()) +
                       ")" + after());
-        by_homotopy.push_back(std::to_string(h));
-        lower.points.clear();
-        for (const auto& pt : b.points) lower.points.emplace_back(pt.lambda, pt.x);
-        lower.harmonics = h;
+        by_homotopy += (by_homotopy.empty() ? "" : ", ") + std::to_string(h);
+        lower = std::move(b);
+        lower_h = h;
       }
       prev = w;
       prev_h = h;
     }
     if (prev_h == eo.n_harmonics) {
       how = "harmonic stepping";
-      if (!by_homotopy.empty()) {
-        std::string levels;
-        for (const std::string& l : by_homotopy) levels += (levels.empty() ? "" : ", ") + l;
-        how += " (the excitation homotopy at H = " + levels + ")";
-      }
+      if (!by_homotopy.empty()) how += " (the excitation homotopy at H = " + by_homotopy + ")";
       say(info, "frf: start point at " + shortest(f) + " Hz by harmonic stepping (H = 1 .. " +
                     std::to_string(eo.n_harmonics) + ")" + after());
       return prev;
