@@ -13,6 +13,12 @@ Eigen::Index StiffnessFactor::rows() const { return real_ ? real_->rows() : comp
 Eigen::MatrixXcd StiffnessFactor::solve(const Eigen::MatrixXcd& b) const {
   SHROUDSIM_CHECK(valid(), "StiffnessFactor::solve without a factor");
   if (real_) {
+    // A real right-hand side (the contact rows of a real harmonic index, 0 or Nb/2) needs no
+    // solve of its zero imaginary part: half the work.
+    if (b.imag().isZero(0.0)) {
+      const Eigen::MatrixXd x = real_->solve(Eigen::MatrixXd(b.real()));
+      return x.cast<Complex>();
+    }
     Eigen::MatrixXd parts(b.rows(), 2 * b.cols());
     parts << b.real(), b.imag();
     const Eigen::MatrixXd x = real_->solve(parts);

@@ -164,7 +164,8 @@ ForcedModel make_sector_model(Context& ctx) {
   // The K_h factors, one per pair of conjugate indices, computed in parallel: each lives only
   // as long as its job, so that at most one per worker is held (a map of them kept every factor
   // until the stage ended: up to five of the 238k-DOF sector's at once).
-  const auto factor = [&](int h) { return modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method); };
+  const modal::HarmonicStiffnessFactors factors(sector, modal.options.factor_method);  // one symbolic analysis
+  const auto factor = [&](int h) { return factors(h); };
   model.linear = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, factor, pairs, forcing, c.hbm.harmonics,
                                                          ctx.threads);
   model.sector_pairs = pairs;

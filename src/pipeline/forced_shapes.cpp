@@ -161,7 +161,8 @@ SectorShapes sector_shapes(const Context& ctx, const forced::ForcedModel& model,
   // K_h^-1 from the receptance stage's solutions where the model kept them, else factors
   // computed in parallel, one per pair of conjugate indices, each held only by its job.
   const cyclic::CyclicSector& sector = modal.cyclic();
-  const auto factor = [&](int h) { return modal::factor_harmonic_stiffness(sector, h, modal.options.factor_method); };
+  const modal::HarmonicStiffnessFactors factors(sector, modal.options.factor_method);  // one symbolic analysis
+  const auto factor = [&](int h) { return factors(h); };
   out.u = frf::sector_displacements(sector, modal.bases, factor, model.sector_pairs, *model.sector_forcing, loads,
                                     dynamic_cast<const frf::SectorLinearPart*>(model.linear.get()), ctx.threads);
   out.mesh = modal.mesh;

@@ -4,6 +4,8 @@
 
 #include <fstream>
 #include <iterator>
+#include <thread>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <filesystem>
@@ -217,6 +219,28 @@ TEST(SolveHarmonic, OneSharedAnalysisGivesTheModesOfAFreshAnalysisBitForBit) {
     const Eigen::MatrixXcd f = Eigen::MatrixXcd::Ones(sector.n_reduced(), 1);
     const auto km = sector.reduce(h);
     EXPECT_LT((km.K * b.stiffness.solve(f) - f).norm(), 1e-9 * f.norm()) << h;
+  }
+}
+
+TEST(HarmonicStiffnessFactors, OneSharedAnalysisGivesTheStaticSolutionsOfFreshFactorsBitForBit) {
+  // The receptance and shape stages factor K_h of several harmonic indices on one analysis
+  // (made by the first call, from several threads at once); the static solutions must be
+  // those of a fresh factorization to the last bit, real indices (0, Nb/2) and complex ones.
+  const auto& sector = bladed_sector();
+  const HarmonicStiffnessFactors factors(sector, linalg::FactorMethod::Supernodal);
+  const Eigen::MatrixXcd f = Eigen::MatrixXcd::Random(sector.n_reduced(), 3);
+  std::vector<int> indices;
+  for (int h = 0; h <= sector.sectors() / 2; ++h) indices.push_back(h);
+  std::vector<Eigen::MatrixXcd> shared(indices.size());
+  std::vector<std::thread> workers;
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    workers.emplace_back([&, i]() { shared[i] = factors(indices[i]).solve(f); });
+  for (auto& w : workers) w.join();
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const int h = indices[i];
+    EXPECT_EQ(shared[i], factor_harmonic_stiffness(sector, h).solve(f)) << h;
+    const auto km = sector.reduce(h);
+    EXPECT_LT((km.K * shared[i] - f).norm(), 1e-9 * f.norm()) << h;
   }
 }
 
