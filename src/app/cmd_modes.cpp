@@ -9,6 +9,7 @@
 #include <cerrno>
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -79,9 +80,9 @@ struct WaitingPlotter {
     wait_exit_status(pid);
     pid = -1;
   }
-  /// Sends the arguments (one per line), closes its stdin and waits: its exit status, -1
+  /// Sends the arguments (one per line) and closes its stdin: it draws from then on. False
   /// when it could not be told.
-  int run(const std::vector<std::string>& args) {
+  bool send(const std::vector<std::string>& args) {
     std::string text;
     for (const auto& a : args) text += a + "\n";
     // A plotter that died early must not take this process with it (SIGPIPE).
@@ -101,6 +102,10 @@ struct WaitingPlotter {
     }
     ::close(pipe);
     ::sigaction(SIGPIPE, &before, nullptr);
+    return sent;
+  }
+  /// Waits for it after send(): its exit status, -1 when it was not told (`sent` false).
+  int wait(bool sent) {
     const int status = wait_exit_status(pid);
     pid = -1;
     return sent ? status : -1;
@@ -134,12 +139,19 @@ EarlyPlotter::EarlyPlotter() {
 
 EarlyPlotter::~EarlyPlotter() { g_plotter.cancel(); }
 
-void draw_plots(Context& ctx) {
-  if (!ctx.plots) return;  // study points: the study plots once at the end
+void draw_plots(Context& ctx, const std::function<void()>& meanwhile) {
+  auto run_meanwhile = [&]() {
+    if (meanwhile) meanwhile();
+  };
+  if (!ctx.plots) {  // study points: the study plots once at the end
+    run_meanwhile();
+    return;
+  }
   if (ctx.no_plots) {
     auto& section = ctx.report.section("plots");
     section["drawn"] = false;
     section["reason"] = "--no-plots";
+    run_meanwhile();
     return;
   }
   const fs::path script = plot_script();
@@ -149,6 +161,7 @@ void draw_plots(Context& ctx) {
     ctx.report.section("plots")["drawn"] = false;
   };
   if (!fs::exists(python) || !fs::exists(script)) {
+    run_meanwhile();
     skipped();
     return;
   }
@@ -163,10 +176,23 @@ void draw_plots(Context& ctx) {
       break;
     }
   // One interpreter start: the script itself says when matplotlib is missing. Started early
-  // (EarlyPlotter), it has imported matplotlib by now and is given the arguments only.
+  // (EarlyPlotter), it has imported matplotlib by now, is given the arguments only and draws
+  // while `meanwhile` runs here.
   constexpr int kNoMatplotlib = 3;  // tools/plot.py NO_MATPLOTLIB
-  const int rc = g_plotter.pid > 0 ? g_plotter.run(std::vector<std::string>(args.begin() + 2, args.end()))
-                                   : run_program(args);
+  int rc = -1;
+  if (g_plotter.pid > 0) {
+    const bool sent = g_plotter.send(std::vector<std::string>(args.begin() + 2, args.end()));
+    try {
+      run_meanwhile();
+    } catch (...) {
+      g_plotter.wait(sent);  // no plotter left behind; the error is what the command reports
+      throw;
+    }
+    rc = g_plotter.wait(sent);
+  } else {
+    run_meanwhile();
+    rc = run_program(args);
+  }
   if (rc == kNoMatplotlib) {
     skipped();
     return;
@@ -186,13 +212,17 @@ int cmd_modes(Context& ctx) {
                      "\": `modes` needs an FE sector (structure.type = \"sector\")");
   ModalModel model = run_modal_stage(ctx, modal_harmonic_indices(c), 0.0, case_shroud(c));
   write_modes_csv(ctx, model);
-  if (!model.bases.empty()) write_modes_vtu(ctx, model);
+  auto write_vtu = [&]() {
+    if (!model.bases.empty()) write_modes_vtu(ctx, model);
+  };
   if (!model.failures.empty()) {
+    write_vtu();
     std::string msg = "modal analysis failed for";
     for (const auto& f : model.failures) msg += "\n  " + f;
     throw NumericalError(msg + "\n(modes.csv holds the harmonic indices that converged)");
   }
-  draw_plots(ctx);
+  // nd_map.png needs modes.csv only: it is drawn while modes.vtu is written.
+  draw_plots(ctx, write_vtu);
   return 0;
 }
 

@@ -2,6 +2,7 @@
 // The subcommands: each maps the case onto pipeline stages and library calls and writes its
 // result files. They are written against the pipeline library (src/pipeline), whose names
 // they use unqualified.
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -33,8 +34,9 @@ nlohmann::json run_report(const Context& ctx, const std::string& command, const 
 
 /// Runs tools/plot.py on the result folder when /usr/bin/python3 has matplotlib; otherwise
 /// says that plots are skipped. A plotting failure is a warning, not an error. Uses the
-/// process an EarlyPlotter started, when there is one.
-void draw_plots(Context& ctx);
+/// process an EarlyPlotter started, when there is one. `meanwhile` (writing result files
+/// that no plot reads) runs while that process draws, and in every case where no plot is drawn.
+void draw_plots(Context& ctx, const std::function<void()>& meanwhile = {});
 
 /// Starts `tools/plot.py --wait` now, so that Python and matplotlib load (0.5 s) while the
 /// command computes; draw_plots then only sends it the arguments. Destroyed before

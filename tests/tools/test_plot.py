@@ -34,8 +34,9 @@ class WaitingPlotter(unittest.TestCase):
             self.assertTrue(os.path.exists(os.path.join(d, "nd_map.png")))
 
     def test_nd_map_has_a_second_panel_only_beyond_ten_families(self):
-        # The PNG's width (bytes 16-19 of its header) tells one panel (7.5 in at 120 dpi) from two (13 in).
-        for families, width in ((2, 900), (10, 900), (12, 1560)):
+        # The PNG's width (bytes 16-19 of its header) tells one panel (7.5 in at 120 dpi) from two
+        # (13 in); both have the legend's 1.3 in beside them.
+        for families, width in ((2, 1056), (10, 1056), (12, 1716)):
             with tempfile.TemporaryDirectory() as d:
                 with open(os.path.join(d, "modes.csv"), "w") as f:
                     f.write("harmonic_index,nodal_diameter,mode,frequency_hz\n")
