@@ -187,31 +187,54 @@ Eigen::VectorXd with_more_harmonics(const Eigen::VectorXd& v, int from_h, const 
   return w;
 }
 
-// Where the excitation homotopy at a stepping level can start instead of the preload-only
-// state: the point of a lower level's homotopy path (`lower`, with `lower_h` harmonics) at the
-// highest excitation scale from which Newton at this level converges (the point padded with
-// zero new harmonics). Found by bisection over the path: Newton converges at low excitation,
-// where the contact barely slips and the new harmonics are small, and has just failed at the
-// full one. Returns scale 0 when no point serves.
-HomotopyStart resume_point(const std::vector<continuation::BranchPoint>& lower, int lower_h, ReducedEquations& level,
-                           const hbm::ContactEvaluator& evaluator, double f, const continuation::ArclengthOptions& ao) {
-  HomotopyStart best;
-  const double full = level.excitation_scale();
-  int lo = 0, hi = static_cast<int>(lower.size()) - 1;
-  while (lo <= hi) {
+}  // namespace
+
+int last_serving_point(int last, const std::function<bool(int)>& serves) {
+  int failed = last;  // the lowest point known to fail
+  int found = -1;
+  for (int gap = 1; found < 0 && last - gap >= 1; gap *= 2) {
+    const int i = last - gap;
+    if (serves(i)) found = i;
+    else failed = i;
+  }
+  if (found < 0 && failed > 1 && serves(1)) found = 1;  // the descent stepped over the lowest points
+  if (found < 0) return -1;
+  // Between the point that serves and the failing one after it.
+  for (int lo = found + 1, hi = failed - 1; lo <= hi;) {
     const int mid = (lo + hi + 1) / 2;
-    const continuation::BranchPoint& p = lower[static_cast<std::size_t>(mid)];
-    Eigen::VectorXd w = with_more_harmonics(p.x, lower_h, evaluator);
-    level.set_excitation_scale(p.lambda);
-    const bool ok = p.lambda > 0.0 && p.lambda < full && continuation::newton_fixed(level, w, f, ao) >= 0;
-    if (ok) {
-      best.scale = p.lambda;
-      best.x = std::move(w);
+    if (serves(mid)) {
+      found = mid;
       lo = mid + 1;
     } else {
       hi = mid - 1;
     }
   }
+  return found;
+}
+
+namespace {
+
+// Where the excitation homotopy at a stepping level can start instead of the preload-only
+// state: a point of a lower level's homotopy path (`lower`, with `lower_h` harmonics) as far
+// along it as can be found (last_serving_point) from which Newton at this level converges (the
+// point padded with zero new harmonics). Returns scale 0 when no point serves.
+HomotopyStart resume_point(const std::vector<continuation::BranchPoint>& lower, int lower_h, ReducedEquations& level,
+                           const hbm::ContactEvaluator& evaluator, double f, const continuation::ArclengthOptions& ao) {
+  HomotopyStart best;
+  const double full = level.excitation_scale();
+  // Newton at this level from point i of the lower path; `best` takes it when it converges.
+  auto serves = [&](int i) {
+    const continuation::BranchPoint& p = lower[static_cast<std::size_t>(i)];
+    if (!(p.lambda > 0.0 && p.lambda < full)) return false;
+    Eigen::VectorXd w = with_more_harmonics(p.x, lower_h, evaluator);
+    level.set_excitation_scale(p.lambda);
+    if (continuation::newton_fixed(level, w, f, ao) < 0) return false;
+    best.scale = p.lambda;
+    best.x = std::move(w);
+    return true;
+  };
+  // The last point is the full excitation, where Newton has just failed.
+  last_serving_point(static_cast<int>(lower.size()) - 1, serves);  // `best` keeps what it found
   level.set_excitation_scale(full);
   return best;
 }

@@ -65,6 +65,20 @@ double free_motion_peak(const frf::LinearPart& linear, const ReducedEquations& e
 continuation::ArclengthOptions arclength_options(const FrequencyResponseSettings& settings, const ForcedModel& model,
                                                  const ReducedEquations& equations);
 
+/// The start search's choice of where on a lower harmonic level's homotopy path (points
+/// 0..last) the next level's homotopy starts: the index of a point that `serves` (Newton at the
+/// new level converges from it), as far along the path as can be found, or -1 when none does.
+/// Newton serves at low excitation, where the contact barely slips and the new harmonics are
+/// small, and has just failed at the last point (the full excitation); but not on one stretch
+/// up to some level: on the 227-pair sector's H = 2 path (86 points) it served from the 21st
+/// and 27th points, not from the 28th, 29th, 30th, 32nd and 43rd, and again from the 69th and
+/// 71st (the excitation level is not monotone along the path either), so that a bisection from
+/// the middle settled at the 27th (the H = 3 path 46 points long, against 15 from the 71st). So the search descends
+/// from the end, the gap doubling (the points last - 1, last - 2, last - 4, ..., then 1), and
+/// bisects between the first point that serves and the failing one after it. Point 0 (the
+/// preload-only state) is never tried.
+int last_serving_point(int last, const std::function<bool(int)>& serves);
+
 /// A solution of `equations` at frequency f: Newton from the stuck-contact solution; where it
 /// fails (Newton cycling between contact states), from the free response, then harmonic
 /// stepping (H = 1, then one harmonic at a time, each new one from zero; a level below H that

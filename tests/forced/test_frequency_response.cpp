@@ -1,13 +1,15 @@
 // The frequency response as the commands trace it (forced/frequency_response.hpp): invariance
 // under a rescaling of time, the default settings on a small chain against a fine reference,
-// resonance peaks located independently of the step, and the same curve whatever the thread
-// count.
+// resonance peaks located independently of the step, the same curve whatever the thread
+// count, and where the start search resumes a lower level's homotopy path.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <numbers>
+#include <vector>
 
 #include "forced/frequency_response.hpp"
 #include "frf/lumped.hpp"
@@ -133,6 +135,39 @@ void expect_time_rescaling_invariance(Lumped (*make)(double)) {
     EXPECT_TRUE(a.located);
     EXPECT_NEAR(a.amplitude_m, b.amplitude_m, kPeakTol * b.amplitude_m) << "s = " << scales[i];
     EXPECT_NEAR(a.frequency_hz * scales[i], b.frequency_hz, kPeakTol * b.frequency_hz) << "s = " << scales[i];
+  }
+}
+
+TEST(StartSearch, TheResumedHomotopyStartsAtTheLastPointThatServesNotAtABoundaryInTheMiddle) {
+  // last_serving_point on patterns of where Newton at the next level converges from a lower
+  // path's points (0..85, the last the full excitation, where it failed). Each pattern names
+  // the answer; the attempts are counted (each is a Newton solve at the new level).
+  struct Pattern {
+    const char* what;
+    std::function<bool(int)> serves;
+    int expected;
+  };
+  const std::vector<Pattern> patterns = {
+      // Like the 227-pair sector's H = 2 path at 96 Hz (BENCHMARKS.md: served at 21, 27, 69 and
+      // 71; failed at 28 to 43 where tried, and from 72 on). A bisection from the middle finds 27.
+      {"two stretches", [](int i) { return (i >= 1 && i <= 27) || (i >= 44 && i <= 71); }, 71},
+      {"one stretch up to 60", [](int i) { return i >= 1 && i <= 60; }, 60},
+      {"only the point before the end", [](int i) { return i == 84; }, 84},
+      {"only the first point", [](int i) { return i == 1; }, 1},
+      {"none", [](int) { return false; }, -1},
+  };
+  for (const Pattern& p : patterns) {
+    int attempts = 0;
+    const int found = last_serving_point(85, [&](int i) {
+      EXPECT_GE(i, 1) << p.what;   // the preload-only state is never tried
+      EXPECT_LT(i, 85) << p.what;  // nor the full excitation, where Newton failed
+      ++attempts;
+      return p.serves(i);
+    });
+    EXPECT_EQ(found, p.expected) << p.what;
+    // The descent takes at most 8 attempts over 85 points and the bisection after it fewer
+    // than the gap it bisects: never more than two bisections of the whole path.
+    EXPECT_LE(attempts, 16) << p.what;
   }
 }
 
