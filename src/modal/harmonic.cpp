@@ -29,10 +29,7 @@ StiffnessFactor factor_on(const linalg::SparsePair<Scalar>& km, linalg::FactorMe
 
 StiffnessFactor factor_harmonic_stiffness(const cyclic::CyclicSector& sector, int h, linalg::FactorMethod method,
                                           const SharedAnalysis* shared) {
-  if (shared == nullptr) {
-    if (sector.is_real(h)) return factor_stiffness(sector.reduce_real(h).K, method);
-    return factor_stiffness(sector.reduce(h).K, method);
-  }
+  // Without `shared`, factor_shifted analyses afresh: factor_stiffness's computation.
   if (sector.is_real(h)) return factor_on(sector.reduce_real(h), method, shared);
   return factor_on(sector.reduce(h), method, shared);
 }

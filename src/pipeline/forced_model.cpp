@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -164,10 +165,9 @@ ForcedModel make_sector_model(Context& ctx) {
   // The K_h factors, one per pair of conjugate indices, computed in parallel: each lives only
   // as long as its job, so that at most one per worker is held (a map of them kept every factor
   // until the stage ended: up to five of the 238k-DOF sector's at once).
-  const modal::HarmonicStiffnessFactors factors(sector, modal.options.factor_method);  // one symbolic analysis
-  const auto factor = [&](int h) { return factors(h); };
-  model.linear = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, factor, pairs, forcing, c.hbm.harmonics,
-                                                         ctx.threads);
+  const modal::HarmonicStiffnessFactors factor(sector, modal.options.factor_method);  // one symbolic analysis
+  model.linear = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, std::cref(factor), pairs, forcing,
+                                                         c.hbm.harmonics, ctx.threads);
   model.sector_pairs = pairs;
   model.sector_forcing = forcing;
   ctx.report.stage("receptances", clock.seconds());

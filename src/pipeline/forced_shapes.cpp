@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 #include <filesystem>
+#include <functional>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -161,10 +162,9 @@ SectorShapes sector_shapes(const Context& ctx, const forced::ForcedModel& model,
   // K_h^-1 from the receptance stage's solutions where the model kept them, else factors
   // computed in parallel, one per pair of conjugate indices, each held only by its job.
   const cyclic::CyclicSector& sector = modal.cyclic();
-  const modal::HarmonicStiffnessFactors factors(sector, modal.options.factor_method);  // one symbolic analysis
-  const auto factor = [&](int h) { return factors(h); };
-  out.u = frf::sector_displacements(sector, modal.bases, factor, model.sector_pairs, *model.sector_forcing, loads,
-                                    dynamic_cast<const frf::SectorLinearPart*>(model.linear.get()), ctx.threads);
+  const modal::HarmonicStiffnessFactors factor(sector, modal.options.factor_method);  // one symbolic analysis
+  out.u = frf::sector_displacements(sector, modal.bases, std::cref(factor), model.sector_pairs, *model.sector_forcing,
+                                    loads, dynamic_cast<const frf::SectorLinearPart*>(model.linear.get()), ctx.threads);
   out.mesh = modal.mesh;
   if (log::detailed())
     log::info(what + ": modal stage " + io::format_number(modal_seconds) + " s, displacements " +
