@@ -212,12 +212,29 @@ int last_serving_point(int last, const std::function<bool(int)>& serves) {
   return found;
 }
 
+int highest_serving_point(const std::vector<double>& levels, double full, const std::function<bool(int)>& serves) {
+  // The candidates in order of increasing level (the path's order among equal levels); the
+  // last is the full excitation, where Newton has just failed, and the first the preload-only
+  // state.
+  std::vector<int> order;
+  for (int i = 1; i + 1 < static_cast<int>(levels.size()); ++i)
+    if (levels[static_cast<std::size_t>(i)] > 0.0 && levels[static_cast<std::size_t>(i)] < full) order.push_back(i);
+  std::stable_sort(order.begin(), order.end(), [&levels](int a, int b) {
+    return levels[static_cast<std::size_t>(a)] < levels[static_cast<std::size_t>(b)];
+  });
+  // Rank k (1 .. size) is order[k - 1]; rank size + 1 stands for the full excitation.
+  const int rank = last_serving_point(static_cast<int>(order.size()) + 1,
+                                      [&](int k) { return serves(order[static_cast<std::size_t>(k - 1)]); });
+  return rank < 0 ? -1 : order[static_cast<std::size_t>(rank - 1)];
+}
+
 namespace {
 
 // Where the excitation homotopy at a stepping level can start instead of the preload-only
-// state: a point of a lower level's homotopy path (`lower`, with `lower_h` harmonics) as far
-// along it as can be found (last_serving_point) from which Newton at this level converges (the
-// point padded with zero new harmonics). Returns scale 0 when no point serves.
+// state: the point of a lower level's homotopy path (`lower`, with `lower_h` harmonics) at the
+// highest excitation level that can be found (highest_serving_point) from which Newton at this
+// level converges (the point padded with zero new harmonics). Returns scale 0 when no point
+// serves.
 HomotopyStart resume_point(const std::vector<continuation::BranchPoint>& lower, int lower_h, ReducedEquations& level,
                            const hbm::ContactEvaluator& evaluator, double f, const continuation::ArclengthOptions& ao) {
   HomotopyStart best;
@@ -225,7 +242,6 @@ HomotopyStart resume_point(const std::vector<continuation::BranchPoint>& lower, 
   // Newton at this level from point i of the lower path; `best` takes it when it converges.
   auto serves = [&](int i) {
     const continuation::BranchPoint& p = lower[static_cast<std::size_t>(i)];
-    if (!(p.lambda > 0.0 && p.lambda < full)) return false;
     Eigen::VectorXd w = with_more_harmonics(p.x, lower_h, evaluator);
     level.set_excitation_scale(p.lambda);
     if (continuation::newton_fixed(level, w, f, ao) < 0) return false;
@@ -233,8 +249,9 @@ HomotopyStart resume_point(const std::vector<continuation::BranchPoint>& lower, 
     best.x = std::move(w);
     return true;
   };
-  // The last point is the full excitation, where Newton has just failed.
-  last_serving_point(static_cast<int>(lower.size()) - 1, serves);  // `best` keeps what it found
+  std::vector<double> levels(lower.size());
+  for (std::size_t i = 0; i < lower.size(); ++i) levels[i] = lower[i].lambda;
+  highest_serving_point(levels, full, serves);  // `best` keeps what it found
   level.set_excitation_scale(full);
   return best;
 }

@@ -79,6 +79,19 @@ continuation::ArclengthOptions arclength_options(const FrequencyResponseSettings
 /// preload-only state) is never tried.
 int last_serving_point(int last, const std::function<bool(int)>& serves);
 
+/// The point of a lower harmonic level's homotopy path (excitation levels `levels`, the last
+/// the full excitation `full`, where Newton at the new level has just failed) from which the
+/// new level's homotopy starts: the points with 0 < level < full, ranked by level, searched by
+/// last_serving_point over the ranks, so that the one found serves at the highest level the
+/// search meets; -1 when none does. A homotopy started higher has less of the way to go, and
+/// the level is not monotone along a path: on the 227-pair sector's H = 1 path at 104 Hz (129
+/// points) it rose to 0.334 at the 44th point, fell back to 0.035 at the 97th and rose to the
+/// full level after it; Newton at H = 2 served from the 1st to the 72nd points but for three,
+/// and from the 90th to the 102nd. The search along the path found the 102nd (level 0.041);
+/// the search by level finds the 44th, in 8 attempts against 10, and the H = 2 path from it
+/// is 11 points long against 79 (docs/continuation.md, "Start").
+int highest_serving_point(const std::vector<double>& levels, double full, const std::function<bool(int)>& serves);
+
 /// A solution of `equations` at frequency f: Newton from the stuck-contact solution; where it
 /// fails (Newton cycling between contact states), from the free response, then harmonic
 /// stepping (H = 1, then one harmonic at a time, each new one from zero; a level below H that

@@ -171,6 +171,38 @@ TEST(StartSearch, TheResumedHomotopyStartsAtTheLastPointThatServesNotAtABoundary
   }
 }
 
+TEST(StartSearch, TheResumedHomotopyStartsAtTheHighestExcitationLevelThatServes) {
+  // Like the 227-pair sector's H = 1 path at 104 Hz (129 points, highest_serving_point): the
+  // excitation level rises to 0.334 at point 44, falls back to 0.035 at point 97 and rises to
+  // the full level 1 at point 128, where Newton at H = 2 failed. Newton serves from points 1 to
+  // 72 but 34, 35 and 69, and from 90 to 102.
+  constexpr int kPoints = 129;
+  std::vector<double> levels(kPoints);
+  for (int i = 0; i < kPoints; ++i)
+    levels[static_cast<std::size_t>(i)] = i <= 44   ? 0.334 * i / 44
+                                          : i <= 97 ? 0.334 + (0.035 - 0.334) * (i - 44) / 53
+                                                    : 0.035 + (1.0 - 0.035) * (i - 97) / 31;
+  auto serves = [](int i) { return (i >= 1 && i <= 72 && i != 34 && i != 35 && i != 69) || (i >= 90 && i <= 102); };
+  int attempts = 0;
+  const int found = highest_serving_point(levels, 1.0, [&](int i) {
+    EXPECT_GE(i, 1);            // the preload-only state is never tried
+    EXPECT_LT(i, kPoints - 1);  // nor the full excitation
+    ++attempts;
+    return serves(i);
+  });
+  EXPECT_EQ(found, 44);  // the highest level at which Newton serves
+  // The same bound as the search along the path: 8 attempts to descend, fewer than the gap after.
+  EXPECT_LE(attempts, 16);
+  // The search along the path stops at the last stretch, at a tenth of that level.
+  EXPECT_EQ(last_serving_point(kPoints - 1, serves), 102);
+  // Nothing serves: -1, and every attempt is within the candidates.
+  EXPECT_EQ(highest_serving_point(levels, 1.0, [](int) { return false; }), -1);
+  // Levels at or above the full one (a path that overshot it) are not candidates.
+  std::vector<double> overshoot = levels;
+  overshoot[44] = 1.0;
+  EXPECT_EQ(highest_serving_point(overshoot, 1.0, serves), 45);
+}
+
 TEST(FrequencyResponse, TimeRescalingGivesTheSameCurveOneDimensionalJenkinsChain) {
   expect_time_rescaling_invariance(+[](double s) { return chain(s); });
 }

@@ -25,10 +25,18 @@ SectorGeometry coarse(int order) {
   return g;
 }
 
+// A file in this process's scratch folder, which is removed when the process exits.
 fs::path temp_file(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("shroudsim_test_mesh_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+  struct Scratch {
+    fs::path dir = fs::temp_directory_path() / ("shroudsim_test_mesh_" + std::to_string(::getpid()));
+    ~Scratch() {
+      std::error_code ignored;
+      fs::remove_all(dir, ignored);
+    }
+  };
+  static const Scratch scratch;
+  fs::create_directories(scratch.dir);
+  return scratch.dir / name;
 }
 
 std::string read_text(const fs::path& p) {
