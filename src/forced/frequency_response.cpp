@@ -370,7 +370,8 @@ bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluator
                            const Info& info) {
   const auto* lumped = dynamic_cast<const frf::LumpedLinearPart*>(model.linear.get());
   if (lumped == nullptr) return false;
-  const LumpedSystem system = lumped_system(*lumped);
+  LumpedSystem system = lumped_system(*lumped);
+  system.force *= equations.excitation_scale();  // the level these equations carry
   TimeMarchOptions to;
   to.output_samples = std::max(eo.n_time_samples, kMarchOutputSamples);
   bool reused = false;

@@ -7,9 +7,12 @@
 
 #include <cmath>
 #include <complex>
+#include <memory>
 #include <numbers>
+#include <string>
 
 #include "continuation/arclength.hpp"
+#include "forced/frequency_response.hpp"
 #include "forced/reduced_equations.hpp"
 #include "forced/time_march.hpp"
 #include "frf/lumped.hpp"
@@ -225,6 +228,59 @@ TEST(TimeMarch, RejectsInconsistentInput) {
   s.mass(0, 0) = -1.0;
   const TimeMarchResult r = march_to_steady_state(s, {pair(1, 1, 0.1, 1)}, contact::Model::one_d, 10.0, {});
   EXPECT_EQ(r.motion, Motion::not_applicable);
+}
+
+// A start found by time integration is found for the excitation the equations carry: with the
+// excitation scaled (the nonlinear-mode stage's comparison runs the harmonic balance at scaled
+// levels), the integration runs at the scaled force. The stress-corpus model of the CLI's
+// subharmonic test (3 DOFs, full-3D contact) with a preload of 2 N at 4.27 Hz has no
+// harmonic-balance start; integrated at the force F it settles on a motion that repeats every
+// two periods (no start), at 0.4 F on a periodic one (the start). The model with force F and
+// the excitation scaled by 0.4 must say exactly what the model with force 0.4 F says. (Without
+// preload the model is homogeneous in the force, and the two integrations settle alike.)
+TEST(TimeMarchStart, AScaledExcitationIsIntegratedAtTheScaledForce) {
+  Eigen::Matrix3d m = Eigen::Vector3d(18.15501439951414, 42.8550096420159, 10.490537497208551).asDiagonal();
+  Eigen::Matrix3d k, c;
+  k << 370681.8733347799, -186888.25051647378, 0.0, -186888.25051647378, 319495.4706231562, -132607.2201066824, 0.0,
+      -132607.2201066824, 223491.84451767677;
+  c << 266.1261834145856, -94.91376025229103, 0.0, -94.91376025229103, 346.07344752183434, -67.34639476877648, 0.0,
+      -67.34639476877648, 158.49930917894164;
+  frf::LumpedContact e;
+  e.dof = {2, 0, 1};
+  e.frame_angle = 15.335515728693025 * std::numbers::pi / 180.0;
+  contact::PairParameters pp;
+  pp.friction_coefficient = 0.49809335994186493;
+  pp.tangential_stiffness = 4453169.612587134;
+  pp.normal_stiffness = 13937757.214890867;
+  pp.normal_preload = 2.0;
+  hbm::ContactEvaluatorOptions eo;
+  eo.n_harmonics = 12;
+  eo.n_time_samples = 128;
+  eo.law.model = contact::Model::full3d;
+  eo.threads = 1;
+  constexpr double kForce = 3.498485488581492, kScale = 0.4, kFrequency = 4.269022959253111;
+  auto attempt = [&](double force, double scale) {
+    ForcedModel model;
+    model.linear = std::make_unique<frf::LumpedLinearPart>(m, k, c, std::vector<frf::LumpedContact>{e}, 2, force, 0);
+    model.pairs = {pp};
+    hbm::ContactEvaluator ev(eo, model.pairs);
+    ReducedEquations eq(*model.linear, ev);
+    eq.set_excitation_scale(scale);
+    FrequencyResponseSettings fs;
+    fs.frequency_start_hz = kFrequency;
+    fs.frequency_end_hz = 12.316202486923972;
+    const continuation::ArclengthOptions ao = arclength_options(fs, model, eq);
+    std::string how;
+    try {
+      find_start(model, eo, eq, ao, kFrequency, how);
+      return "start by " + how;
+    } catch (const std::exception& error) {
+      return std::string(error.what());
+    }
+  };
+  const std::string scaled = attempt(kForce, kScale), direct = attempt(kScale * kForce, 1.0);
+  EXPECT_NE(direct.find("start by time integration"), std::string::npos) << direct;  // a periodic motion
+  EXPECT_EQ(scaled, direct);
 }
 
 }  // namespace
