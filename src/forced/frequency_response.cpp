@@ -416,6 +416,7 @@ bool start_from_time_march(const ForcedModel& model, const hbm::ContactEvaluator
     const std::string settings = "H = " + std::to_string(h) + ", N = " + std::to_string(finer.n_time_samples);
     hbm::ContactEvaluator evaluator(finer, model.pairs);
     ReducedEquations fine(*model.linear, evaluator);
+    fine.set_excitation_scale(equations.excitation_scale());  // the level the motion was integrated at
     Eigen::VectorXd xf = harmonic_unknowns(tm.contact_motion, h, contact::n_directions(eo.law.model));
     continuation::ArclengthOptions fo = patient;
     fo.x_scale = Eigen::VectorXd::Constant(xf.size(), ao.x_scale[0]);
