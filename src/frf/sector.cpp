@@ -208,6 +208,24 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
     if (h >= 0) solutions_[h] = std::move(y);
 }
 
+SectorLinearPart::SectorLinearPart(Precomputed data, std::vector<SectorContactPair> pairs, SectorForcing forcing,
+                                   int sectors, int n_harmonics)
+    : pairs_(std::move(pairs)),
+      forcing_(forcing),
+      sectors_(sectors),
+      n_harmonics_(n_harmonics),
+      dynamic_(std::move(data.dynamic)),
+      static_(std::move(data.statics)) {
+  const Eigen::Index k = n_contact() + 4;
+  SHROUDSIM_CHECK(static_.flex.rows() == k && static_.flex.cols() == k, "precomputed static flexibility of size k");
+  for (int n = 1; n <= n_harmonics_; ++n)
+    SHROUDSIM_CHECK(dynamic_.count(harmonic_index(n)) == 1,
+                    "precomputed data of harmonic index " + std::to_string(harmonic_index(n)));
+  for (const auto& [h, d] : dynamic_)
+    SHROUDSIM_CHECK(d.psi.rows() == k && d.flex.rows() == k && d.psi.cols() == d.omega.size(),
+                    "precomputed data of harmonic index " + std::to_string(h) + " of consistent sizes");
+}
+
 const Eigen::MatrixXcd* SectorLinearPart::static_solution(int h, bool& conjugated) const {
   conjugated = false;
   if (auto it = solutions_.find(h); it != solutions_.end()) return &it->second;

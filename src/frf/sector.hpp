@@ -133,12 +133,25 @@ class SectorLinearPart : public LinearPart {
   /// is its complex conjugate). nullptr: not kept.
   const Eigen::MatrixXcd* static_solution(int h, bool& conjugated) const;
 
- private:
   struct IndexData {
     Eigen::VectorXd omega;  ///< modes kept [rad/s]
     Eigen::MatrixXcd psi;   ///< k x modes: C T_h phi
     Eigen::MatrixXcd flex;  ///< k x k: residual flexibility (n >= 1) or static flexibility (h used for n = 0)
   };
+  /// What the construction computes from the K_h factors and the modes: all the receptances
+  /// need (the receptance stage's cache entry, pipeline/forced_model.cpp).
+  struct Precomputed {
+    IndexData statics;                 ///< n = 0
+    std::map<int, IndexData> dynamic;  ///< per harmonic index
+  };
+  Precomputed precomputed() const { return {static_, dynamic_}; }
+  /// The model from an earlier construction's precomputed data (of the same sector, modes,
+  /// pairs and forcing rows): the same receptances, bit for bit, without factorizing; no
+  /// static solution is kept (static_solution() is nullptr: the shapes factorize).
+  SectorLinearPart(Precomputed data, std::vector<SectorContactPair> pairs, SectorForcing forcing, int sectors,
+                   int n_harmonics);
+
+ private:
   /// Q_n(W) (k x k).
   Eigen::MatrixXcd receptance(int n, double w) const;
   /// The data of harmonic index g (0..Nb-1), stored as g or as its conjugate Nb - g; nullptr

@@ -12,8 +12,9 @@
 namespace shroudsim::modal {
 namespace {
 
-constexpr std::uint64_t kMagicBasis = 0x32534142444f4d53ull;  // "SMODBAS2": key and checksum
-constexpr std::uint64_t kMagicMesh = 0x3248534548534d53ull;   // "SMSHESH2" (version digit last)
+constexpr std::uint64_t kMagicBasis = 0x32534142444f4d53ull;   // "SMODBAS2": key and checksum
+constexpr std::uint64_t kMagicMesh = 0x3248534548534d53ull;    // "SMSHESH2" (version digit last)
+constexpr std::uint64_t kMagicArrays = 0x3253594152524153ull;  // "SARRAYS2"
 
 // Largest cache file read (50 modes of a 240k-DOF sector are about 0.2 GB).
 constexpr std::uintmax_t kMaxCacheBytes = 8ull << 30;
@@ -256,6 +257,42 @@ std::optional<ModalBasis> load_basis(const std::filesystem::path& path, const st
   if (!get_array(*in, b.phi.data(), rows * count)) return bad();
   if (!b.omega.allFinite() || !b.phi.allFinite()) return bad();
   return b;
+}
+
+void save_arrays(const std::filesystem::path& path, const std::string& key, const TaggedArrays& arrays) {
+  write_atomic(path, kMagicArrays, key, [&](std::ostream& out) {
+    put<std::int64_t>(out, static_cast<std::int64_t>(arrays.tags.size()));
+    put_array(out, arrays.tags.data(), static_cast<std::int64_t>(arrays.tags.size()));
+    put<std::int64_t>(out, static_cast<std::int64_t>(arrays.vectors.size()));
+    for (const auto& v : arrays.vectors) put_matrix(out, v);
+    put<std::int64_t>(out, static_cast<std::int64_t>(arrays.matrices.size()));
+    for (const auto& m : arrays.matrices) put_matrix(out, m);
+  });
+}
+
+std::optional<TaggedArrays> load_arrays(const std::filesystem::path& path, const std::string& key,
+                                        std::string* problem) {
+  auto in = read_entry(path, kMagicArrays, key, problem);
+  if (!in) return std::nullopt;
+  auto bad = [&]() -> std::optional<TaggedArrays> {
+    if (problem) *problem = "malformed payload";
+    return std::nullopt;
+  };
+  constexpr std::int64_t kMaxCount = 1 << 20, kMaxEntries = std::int64_t{1} << 32;
+  TaggedArrays a;
+  std::int64_t n = 0;
+  if (!get(*in, n) || n < 0 || n > kMaxCount) return bad();
+  a.tags.resize(static_cast<std::size_t>(n));
+  if (!get_array(*in, a.tags.data(), n)) return bad();
+  if (!get(*in, n) || n < 0 || n > kMaxCount) return bad();
+  a.vectors.resize(static_cast<std::size_t>(n));
+  for (auto& v : a.vectors)
+    if (!get_matrix(*in, v, kMaxEntries) || !v.allFinite()) return bad();
+  if (!get(*in, n) || n < 0 || n > kMaxCount) return bad();
+  a.matrices.resize(static_cast<std::size_t>(n));
+  for (auto& m : a.matrices)
+    if (!get_matrix(*in, m, kMaxEntries) || !m.allFinite()) return bad();
+  return a;
 }
 
 }  // namespace shroudsim::modal

@@ -8,9 +8,12 @@
 // overwrites it. Writes go to a temporary file renamed into place, so an interrupted run
 // leaves no partial entry. Keys (also the file names) are built by the caller from
 // fe::Hasher fingerprints of everything the entry depends on.
+#include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "linalg/sparse.hpp"
 #include "mesh/mesh.hpp"
@@ -28,5 +31,17 @@ std::optional<ModalBasis> load_basis(const std::filesystem::path& path, const st
 void save_mesh(const std::filesystem::path& path, const std::string& key, const mesh::Mesh& mesh);
 std::optional<mesh::Mesh> load_mesh(const std::filesystem::path& path, const std::string& key,
                                     std::string* problem = nullptr);
+
+/// Real vectors and complex matrices, each with an integer tag (the forced response's
+/// receptance data, pipeline/forced_model.cpp, docs/contract.md "Cache").
+struct TaggedArrays {
+  std::vector<std::int64_t> tags;
+  std::vector<Eigen::VectorXd> vectors;
+  std::vector<Eigen::MatrixXcd> matrices;
+};
+void save_arrays(const std::filesystem::path& path, const std::string& key, const TaggedArrays& arrays);
+/// nullopt (with a problem) also when any value is not finite.
+std::optional<TaggedArrays> load_arrays(const std::filesystem::path& path, const std::string& key,
+                                        std::string* problem = nullptr);
 
 }  // namespace shroudsim::modal

@@ -16,11 +16,13 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "fe/fingerprint.hpp"
 #include "frf/contact_patches.hpp"
 #include "frf/lumped.hpp"
 #include "frf/sector.hpp"
 #include "frf/static_shroud.hpp"
 #include "io/output.hpp"
+#include "modal/cache.hpp"
 #include "modal/harmonic.hpp"
 #include "modal/rotating.hpp"
 #include "pipeline/forced_model.hpp"
@@ -30,6 +32,99 @@ namespace shroudsim::pipeline {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
+
+// The fingerprint of everything the sector's receptance data depends on (frf::SectorLinearPart::
+// Precomputed): the sector (mesh, its K and M as used, the tied shroud springs), the modes
+// themselves, the contact rows (pairs, frames, patches), the forcing rows (response and
+// excitation nodes, the force), the harmonic indices and the factorization method (its
+// round-off). Not the contact law, the damping or the frequencies.
+std::string receptances_key(const ModalModel& modal, const std::vector<frf::SectorContactPair>& pairs,
+                            const frf::SectorForcing& forcing, int n_harmonics) {
+  fe::Hasher h;
+  h.add(std::string("receptances 1"));
+  fe::hash_into(h, modal.mesh);
+  for (const auto* a : {&modal.km.K, &modal.km.M}) {
+    SHROUDSIM_CHECK(a->isCompressed(), "K and M compressed");
+    h.add(a->rows());
+    h.add(a->nonZeros());
+    h.add_bytes(a->valuePtr(), sizeof(*a->valuePtr()) * static_cast<std::size_t>(a->nonZeros()));
+    h.add_bytes(a->innerIndexPtr(), sizeof(*a->innerIndexPtr()) * static_cast<std::size_t>(a->nonZeros()));
+    h.add_bytes(a->outerIndexPtr(), sizeof(*a->outerIndexPtr()) * static_cast<std::size_t>(a->outerSize() + 1));
+  }
+  h.add(modal.interface.size());
+  for (const auto& s : modal.interface) {
+    h.add(s.high_node);
+    h.add(s.low_node);
+    h.add_bytes(s.frame.data(), sizeof(double) * 9);
+    h.add_bytes(s.stiffness.data(), sizeof(double) * 3);
+  }
+  h.add(static_cast<int>(modal.options.factor_method));
+  for (const auto& [index, b] : modal.bases) {
+    h.add(index);
+    h.add(b.omega.size());
+    h.add_bytes(b.omega.data(), sizeof(double) * static_cast<std::size_t>(b.omega.size()));
+    h.add(b.phi.rows());
+    h.add_bytes(b.phi.data(), sizeof(*b.phi.data()) * static_cast<std::size_t>(b.phi.size()));
+  }
+  h.add(pairs.size());
+  for (const auto& p : pairs) {
+    h.add(p.high_node);
+    h.add(p.low_node);
+    h.add_bytes(p.frame.data(), sizeof(double) * 9);
+    h.add(p.patch.size());
+    for (const auto& m : p.patch) {
+      h.add(m.high_node);
+      h.add(m.low_node);
+      h.add(m.weight);
+    }
+  }
+  h.add(forcing.engine_order);
+  h.add(forcing.excitation_node);
+  h.add_bytes(forcing.force.data(), sizeof(double) * 3);
+  h.add(forcing.response_node);
+  h.add(static_cast<int>(forcing.residual_flexibility));
+  h.add(n_harmonics);
+  return h.hex();
+}
+
+// The cache entry of the receptance data: per block (the static one tagged -1, then each
+// harmonic index) omega as a vector, psi and flex as matrices.
+modal::TaggedArrays pack(const frf::SectorLinearPart::Precomputed& p) {
+  modal::TaggedArrays a;
+  auto add = [&a](std::int64_t tag, const frf::SectorLinearPart::IndexData& d) {
+    a.tags.push_back(tag);
+    a.vectors.push_back(d.omega);
+    a.matrices.push_back(d.psi);
+    a.matrices.push_back(d.flex);
+  };
+  add(-1, p.statics);
+  for (const auto& [index, d] : p.dynamic) add(index, d);
+  return a;
+}
+
+// The data back, or nullopt when the entry's blocks are not those of this model (k rows and
+// columns of flex, k rows of psi and one column per mode, each index once).
+std::optional<frf::SectorLinearPart::Precomputed> unpack(modal::TaggedArrays a, Eigen::Index k) {
+  const std::size_t blocks = a.tags.size();
+  if (blocks == 0 || a.vectors.size() != blocks || a.matrices.size() != 2 * blocks || a.tags.front() != -1)
+    return std::nullopt;
+  frf::SectorLinearPart::Precomputed p;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    frf::SectorLinearPart::IndexData d;
+    d.omega = std::move(a.vectors[b]);
+    d.psi = std::move(a.matrices[2 * b]);
+    d.flex = std::move(a.matrices[2 * b + 1]);
+    if (d.flex.rows() != k || d.flex.cols() != k || d.psi.rows() != (d.omega.size() ? k : d.psi.rows()) ||
+        d.psi.cols() != d.omega.size())
+      return std::nullopt;
+    if (b == 0) {
+      p.statics = std::move(d);
+    } else if (a.tags[b] < 0 || !p.dynamic.emplace(static_cast<int>(a.tags[b]), std::move(d)).second) {
+      return std::nullopt;
+    }
+  }
+  return p;
+}
 
 contact::PairParameters pair_of(const io::ContactSection& c, const io::ContactElement* e) {
   contact::PairParameters p;
@@ -162,15 +257,43 @@ ForcedModel make_sector_model(Context& ctx) {
   forcing.residual_flexibility = c.modal.residual_flexibility;
   log::Stopwatch clock;
   const cyclic::CyclicSector& sector = modal.cyclic();
-  // The K_h factors, one per pair of conjugate indices, computed in parallel: each lives only
-  // as long as its job, so that at most one per worker is held (a map of them kept every factor
-  // until the stage ended: up to five of the 238k-DOF sector's at once).
-  const modal::HarmonicStiffnessFactors factor(sector, modal.options.factor_method);  // one symbolic analysis
-  model.linear = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, std::cref(factor), pairs, forcing,
-                                                         c.hbm.harmonics, ctx.threads);
+  // The receptance data is reused from the case directory's cache when everything it depends
+  // on is unchanged (receptances_key): a run that changes only the contact law, the damping,
+  // the excitation's level or the range factorizes nothing (docs/contract.md, "Cache").
+  const std::string key = receptances_key(modal, pairs, forcing, c.hbm.harmonics);
+  const std::filesystem::path entry = c.directory / ".cache" / ("receptances-" + key + ".bin");
+  std::string problem;
+  bool reused = false;
+  if (auto arrays = modal::load_arrays(entry, key, &problem)) {
+    if (auto data = unpack(std::move(*arrays), 3 * static_cast<Eigen::Index>(pairs.size()) + 4)) {
+      model.linear =
+          std::make_unique<frf::SectorLinearPart>(std::move(*data), pairs, forcing, sector.sectors(), c.hbm.harmonics);
+      reused = true;
+    } else {
+      problem = "its blocks do not fit this model";
+    }
+  }
+  if (!problem.empty())
+    ctx.report.warn("the cache entry " + entry.string() + " is not used (" + problem + "); recomputing it");
+  if (!reused) {
+    // The K_h factors, one per pair of conjugate indices, computed in parallel: each lives only
+    // as long as its job, so that at most one per worker is held (a map of them kept every factor
+    // until the stage ended: up to five of the 238k-DOF sector's at once).
+    const modal::HarmonicStiffnessFactors factor(sector, modal.options.factor_method);  // one symbolic analysis
+    auto part = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, std::cref(factor), pairs, forcing,
+                                                        c.hbm.harmonics, ctx.threads);
+    try {
+      modal::save_arrays(entry, key, pack(part->precomputed()));
+    } catch (const std::exception& e) {
+      ctx.report.warn(std::string("the receptances could not be cached: ") + e.what());
+    }
+    model.linear = std::move(part);
+  }
   model.sector_pairs = pairs;
   model.sector_forcing = forcing;
-  ctx.report.stage("receptances", clock.seconds());
+  ctx.report.stage("receptances", clock.seconds(), reused);
+  ctx.report.section("frf_model")["receptances"] = {{"cache_entry", entry.string()}, {"reused", reused}};
+  if (reused) log::info("frf: receptances reused from " + entry.string());
   if (log::detailed()) {
     const auto& part = static_cast<const frf::SectorLinearPart&>(*model.linear);
     for (const auto& t : part.build_times()) {

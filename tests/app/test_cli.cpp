@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <utility>
 
 #include "cli_runner.hpp"
 
@@ -447,11 +449,11 @@ TEST(Cli, ContactCommandWritesTheCircularOrbitSolution) {
 namespace shroudsim::testing {
 namespace {
 
-TEST(Cli, SectorForcedResponseRunsEndToEndWithFullThreeDimensionalContact) {
-  // A coarse sector (4-node tets), 3 shroud pairs, full3d contact, H = 3: mesh -> modes ->
-  // receptances -> harmonic balance -> continuation, through the command line.
-  const Scratch s("sector_frf");
-  s.write("case.toml", R"(name = "sector"
+// A coarse sector (4-node tets, 10 modes per index), 3 shroud pairs, full3d contact, H = 3,
+// N = 64, traced from f0 to f1 Hz.
+std::string coarse_sector_case(double f0, double f1) {
+  std::ostringstream c;
+  c << R"(name = "sector"
 [geometry]
 element_order = 1
 mesh_size = 0.03
@@ -464,10 +466,17 @@ pairs = 3
 harmonics = 3
 time_samples = 64
 [continuation]
-frequency_start_hz = 80.0
-frequency_end_hz = 130.0
 initial_step = 0.5
-)");
+frequency_start_hz = )"
+    << f0 << "\nfrequency_end_hz = " << f1 << "\n";
+  return c.str();
+}
+
+TEST(Cli, SectorForcedResponseRunsEndToEndWithFullThreeDimensionalContact) {
+  // A coarse sector (4-node tets), 3 shroud pairs, full3d contact, H = 3: mesh -> modes ->
+  // receptances -> harmonic balance -> continuation, through the command line.
+  const Scratch s("sector_frf");
+  s.write("case.toml", coarse_sector_case(80.0, 130.0));
   const CliResult r = s.run("frf case.toml --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string run = slurp(s.dir() / "results" / "sector" / "run.json");
@@ -486,6 +495,51 @@ initial_step = 0.5
   EXPECT_NE(stability["reason"].get<std::string>().find("memory"), std::string::npos);
   const auto lines = lines_of(slurp(s.dir() / "results" / "sector" / "frf.csv"));
   EXPECT_EQ(lines[0].find("stable"), std::string::npos) << lines[0];
+}
+
+TEST(Cli, ReceptancesAreReusedWhereOnlyTheContactLawChangesAndRecomputedWhereTheirInputsDo) {
+  // The receptance stage's data (factorizations of every K_h, static and residual
+  // flexibility) is cached under the fingerprint of what it depends on: the same case again,
+  // or another friction coefficient, reuses it and factorizes nothing; another set of contact
+  // pairs does not; a damaged entry is recomputed with a warning. The curve from a reused
+  // entry is the same file, byte for byte.
+  const Scratch s("receptance_cache");
+  s.write("case.toml", coarse_sector_case(95.0, 100.0));
+  auto run = [&](const std::string& out, const std::string& extra) {
+    const CliResult r = s.run("frf case.toml --quiet --no-plots --out " + out + extra);
+    EXPECT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(slurp(s.dir() / out / "run.json"));
+    return std::make_pair(j["frf_model"]["receptances"], r.err);
+  };
+  const auto [first, first_err] = run("a", "");
+  EXPECT_FALSE(first["reused"].get<bool>());
+  const fs::path entry = first["cache_entry"].get<std::string>();
+  ASSERT_TRUE(fs::exists(entry));
+  const auto [again, again_err] = run("b", "");
+  EXPECT_TRUE(again["reused"].get<bool>());
+  EXPECT_EQ(slurp(s.dir() / "b" / "frf.csv"), slurp(s.dir() / "a" / "frf.csv"));
+  const auto [friction, friction_err] = run("c", " --set contact.friction_coefficient=0.6");
+  EXPECT_TRUE(friction["reused"].get<bool>());
+  EXPECT_NE(slurp(s.dir() / "c" / "frf.csv"), slurp(s.dir() / "a" / "frf.csv"));  // another curve
+  const auto [pairs, pairs_err] = run("d", " --set contact.pairs=2");
+  EXPECT_FALSE(pairs["reused"].get<bool>());
+  EXPECT_NE(pairs["cache_entry"].get<std::string>(), entry.string());
+  // One byte changed in the middle of the entry: not used, said, recomputed and rewritten.
+  {
+    std::fstream f(entry, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(static_cast<std::streamoff>(fs::file_size(entry) / 2));
+    char c = 0;
+    f.read(&c, 1);
+    f.seekp(static_cast<std::streamoff>(fs::file_size(entry) / 2));
+    c = static_cast<char>(c ^ 0x5a);
+    f.write(&c, 1);
+  }
+  const auto [damaged, damaged_err] = run("e", "");
+  EXPECT_FALSE(damaged["reused"].get<bool>());
+  EXPECT_NE(damaged_err.find("checksum"), std::string::npos) << damaged_err;
+  EXPECT_EQ(slurp(s.dir() / "e" / "frf.csv"), slurp(s.dir() / "a" / "frf.csv"));
+  const auto [rewritten, rewritten_err] = run("f", "");
+  EXPECT_TRUE(rewritten["reused"].get<bool>());
 }
 
 }  // namespace
