@@ -33,7 +33,7 @@ std::optional<mesh::Mesh> load_mesh(const std::filesystem::path& path, const std
                                     std::string* problem = nullptr);
 
 /// Real vectors and complex matrices, each with an integer tag (the forced response's
-/// receptance data, pipeline/forced_model.cpp, docs/contract.md "Cache").
+/// receptance data, pipeline/forced_model.cpp, docs/contract.md frf_model.receptances).
 struct TaggedArrays {
   std::vector<std::int64_t> tags;
   std::vector<Eigen::VectorXd> vectors;

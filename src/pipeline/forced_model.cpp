@@ -258,8 +258,8 @@ ForcedModel make_sector_model(Context& ctx) {
   log::Stopwatch clock;
   const cyclic::CyclicSector& sector = modal.cyclic();
   // The receptance data is reused from the case directory's cache when everything it depends
-  // on is unchanged (receptances_key): a run that changes only the contact law, the damping,
-  // the excitation's level or the range factorizes nothing (docs/contract.md, "Cache").
+  // on is unchanged (receptances_key): a run that changes only the contact law, N, the damping,
+  // the range or the continuation factorizes nothing (docs/contract.md, frf_model.receptances).
   const std::string key = receptances_key(modal, pairs, forcing, c.hbm.harmonics);
   const std::filesystem::path entry = c.directory / ".cache" / ("receptances-" + key + ".bin");
   std::string problem;
