@@ -210,20 +210,24 @@ SectorLinearPart::SectorLinearPart(const cyclic::CyclicSector& sector, const std
 
 SectorLinearPart::SectorLinearPart(Precomputed data, std::vector<SectorContactPair> pairs, SectorForcing forcing,
                                    int sectors, int n_harmonics)
-    : pairs_(std::move(pairs)),
-      forcing_(forcing),
-      sectors_(sectors),
-      n_harmonics_(n_harmonics),
-      dynamic_(std::move(data.dynamic)),
-      static_(std::move(data.statics)) {
-  const Eigen::Index k = n_contact() + 4;
-  SHROUDSIM_CHECK(static_.flex.rows() == k && static_.flex.cols() == k, "precomputed static flexibility of size k");
+    : pairs_(std::move(pairs)), forcing_(forcing), sectors_(sectors), n_harmonics_(n_harmonics) {
+  SHROUDSIM_CHECK(data.fits(n_contact() + 4), "precomputed data of this model's sizes");
+  dynamic_ = std::move(data.dynamic);
+  static_ = std::move(data.statics);
   for (int n = 1; n <= n_harmonics_; ++n)
     SHROUDSIM_CHECK(dynamic_.count(harmonic_index(n)) == 1,
                     "precomputed data of harmonic index " + std::to_string(harmonic_index(n)));
-  for (const auto& [h, d] : dynamic_)
-    SHROUDSIM_CHECK(d.psi.rows() == k && d.flex.rows() == k && d.psi.cols() == d.omega.size(),
-                    "precomputed data of harmonic index " + std::to_string(h) + " of consistent sizes");
+}
+
+bool SectorLinearPart::Precomputed::fits(Eigen::Index k) const {
+  auto fits_block = [k](const IndexData& d) {
+    return d.flex.rows() == k && d.flex.cols() == k && d.psi.cols() == d.omega.size() &&
+           (d.omega.size() == 0 || d.psi.rows() == k);
+  };
+  if (!fits_block(statics)) return false;
+  for (const auto& [h, d] : dynamic)
+    if (!fits_block(d)) return false;
+  return true;
 }
 
 const Eigen::MatrixXcd* SectorLinearPart::static_solution(int h, bool& conjugated) const {

@@ -143,6 +143,9 @@ class SectorLinearPart : public LinearPart {
   struct Precomputed {
     IndexData statics;                 ///< n = 0
     std::map<int, IndexData> dynamic;  ///< per harmonic index
+    /// Every block has k x k flex and k x modes psi (k = 3 pairs + 4: contact, response and
+    /// excitation rows); the static block may have no modes (and no psi).
+    bool fits(Eigen::Index k) const;
   };
   Precomputed precomputed() const { return {static_, dynamic_}; }
   /// The model from an earlier construction's precomputed data (of the same sector, modes,

@@ -114,15 +114,13 @@ std::optional<frf::SectorLinearPart::Precomputed> unpack(modal::TaggedArrays a, 
     d.omega = std::move(a.vectors[b]);
     d.psi = std::move(a.matrices[2 * b]);
     d.flex = std::move(a.matrices[2 * b + 1]);
-    if (d.flex.rows() != k || d.flex.cols() != k || d.psi.rows() != (d.omega.size() ? k : d.psi.rows()) ||
-        d.psi.cols() != d.omega.size())
-      return std::nullopt;
     if (b == 0) {
       p.statics = std::move(d);
     } else if (a.tags[b] < 0 || !p.dynamic.emplace(static_cast<int>(a.tags[b]), std::move(d)).second) {
       return std::nullopt;
     }
   }
+  if (!p.fits(k)) return std::nullopt;
   return p;
 }
 
