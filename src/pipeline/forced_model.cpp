@@ -3,7 +3,9 @@
 // response nodes (docs/physics.md sections 2 and 3).
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -33,15 +35,55 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
+// The excitation row of the receptance data (row c + 3 of C_h, docs/physics.md section 3) is the
+// force times the excitation node's rows, so the data is linear in the force: an entry serves any
+// multiple of the force it was computed with, rescaled (rescale_excitation). The key holds the
+// force's direction only: the force over its largest component (1 there exactly, whatever the
+// multiple), rounded to 2^-40; zero for no force.
+std::array<std::int64_t, 3> force_direction(const Eigen::Vector3d& f) {
+  std::array<std::int64_t, 3> d{0, 0, 0};
+  Eigen::Index largest = 0;
+  if (f.cwiseAbs().maxCoeff(&largest) == 0.0) return d;
+  for (int a = 0; a < 3; ++a) d[static_cast<std::size_t>(a)] = std::llround(std::ldexp(f[a] / f[largest], 40));
+  return d;
+}
+
+// The factor a with force = a * computed_with, or nullopt when the two are not parallel (to
+// 1e-12 of the force: the rounding of force_direction) or one of them is zero and the other not.
+std::optional<double> force_ratio(const Eigen::Vector3d& force, const Eigen::Vector3d& computed_with) {
+  constexpr double kParallel = 1e-12;
+  if (force == computed_with) return 1.0;  // the same entry: the data as computed, bit for bit
+  Eigen::Index largest = 0;
+  if (computed_with.cwiseAbs().maxCoeff(&largest) == 0.0 || force.isZero(0.0)) return std::nullopt;
+  const double a = force[largest] / computed_with[largest];
+  if ((force - a * computed_with).norm() > kParallel * force.norm()) return std::nullopt;
+  return a;
+}
+
+// The data for the force a times the one it was computed with: the excitation row and column
+// (the last, k - 1) of every block's psi and flex scaled by a (flex(k - 1, k - 1) by a^2, as
+// C_h K_h^-1 C_h^H has it).
+void rescale_excitation(frf::SectorLinearPart::Precomputed& p, double a) {
+  auto scale = [a](frf::SectorLinearPart::IndexData& d) {
+    const Eigen::Index e = d.flex.rows() - 1;
+    if (d.psi.rows() == d.flex.rows()) d.psi.row(e) *= a;
+    d.flex.row(e) *= a;
+    d.flex.col(e) *= a;
+  };
+  scale(p.statics);
+  for (auto& [h, d] : p.dynamic) scale(d);
+}
+
 // The fingerprint of everything the sector's receptance data depends on (frf::SectorLinearPart::
 // Precomputed): the sector (mesh, its K and M as used, the tied shroud springs), the modes
 // themselves, the contact rows (pairs, frames, patches), the forcing rows (response and
-// excitation nodes, the force), the harmonic indices and the factorization method (its
-// round-off). Not the contact law, the damping or the frequencies.
+// excitation nodes, the force's direction: force_direction), the harmonic indices and the
+// factorization method (its round-off). Not the contact law, the damping, the frequencies or the
+// force's size.
 std::string receptances_key(const ModalModel& modal, const std::vector<frf::SectorContactPair>& pairs,
                             const frf::SectorForcing& forcing, int n_harmonics) {
   fe::Hasher h;
-  h.add(std::string("receptances 1"));
+  h.add(std::string("receptances 2"));
   fe::hash_into(h, modal.mesh);
   for (const auto* a : {&modal.km.K, &modal.km.M}) {
     SHROUDSIM_CHECK(a->isCompressed(), "K and M compressed");
@@ -80,7 +122,7 @@ std::string receptances_key(const ModalModel& modal, const std::vector<frf::Sect
   }
   h.add(forcing.engine_order);
   h.add(forcing.excitation_node);
-  h.add_bytes(forcing.force.data(), sizeof(double) * 3);
+  h.add(force_direction(forcing.force));
   h.add(forcing.response_node);
   h.add(static_cast<int>(forcing.residual_flexibility));
   h.add(n_harmonics);
@@ -88,8 +130,11 @@ std::string receptances_key(const ModalModel& modal, const std::vector<frf::Sect
 }
 
 // The cache entry of the receptance data: per block (the static one tagged -1, then each
-// harmonic index) omega as a vector, psi and flex as matrices.
-modal::TaggedArrays pack(const frf::SectorLinearPart::Precomputed& p) {
+// harmonic index) omega as a vector, psi and flex as matrices; last, tagged -2, the force the
+// data was computed with (a vector, no matrices).
+constexpr std::int64_t kStaticTag = -1, kForceTag = -2;
+
+modal::TaggedArrays pack(const frf::SectorLinearPart::Precomputed& p, const Eigen::Vector3d& force) {
   modal::TaggedArrays a;
   auto add = [&a](std::int64_t tag, const frf::SectorLinearPart::IndexData& d) {
     a.tags.push_back(tag);
@@ -97,31 +142,40 @@ modal::TaggedArrays pack(const frf::SectorLinearPart::Precomputed& p) {
     a.matrices.push_back(d.psi);
     a.matrices.push_back(d.flex);
   };
-  add(-1, p.statics);
+  add(kStaticTag, p.statics);
   for (const auto& [index, d] : p.dynamic) add(index, d);
+  a.tags.push_back(kForceTag);
+  a.vectors.emplace_back(force);
   return a;
 }
 
-// The data back, or nullopt when the entry's blocks are not those of this model (k rows and
-// columns of flex, k rows of psi and one column per mode, each index once).
-std::optional<frf::SectorLinearPart::Precomputed> unpack(modal::TaggedArrays a, Eigen::Index k) {
-  const std::size_t blocks = a.tags.size();
-  if (blocks == 0 || a.vectors.size() != blocks || a.matrices.size() != 2 * blocks || a.tags.front() != -1)
+struct ReceptanceEntry {
+  frf::SectorLinearPart::Precomputed data;
+  Eigen::Vector3d force;  ///< the force the data was computed with
+};
+
+// The entry back, or nullopt when its blocks are not those of this model (k rows and columns of
+// flex, k rows of psi and one column per mode, each index once, the force last).
+std::optional<ReceptanceEntry> unpack(modal::TaggedArrays a, Eigen::Index k) {
+  const std::size_t blocks = a.tags.size() - 1;  // and the force
+  if (a.tags.size() < 2 || a.vectors.size() != blocks + 1 || a.matrices.size() != 2 * blocks ||
+      a.tags.front() != kStaticTag || a.tags.back() != kForceTag || a.vectors.back().size() != 3)
     return std::nullopt;
-  frf::SectorLinearPart::Precomputed p;
+  ReceptanceEntry e;
+  e.force = a.vectors.back();
   for (std::size_t b = 0; b < blocks; ++b) {
     frf::SectorLinearPart::IndexData d;
     d.omega = std::move(a.vectors[b]);
     d.psi = std::move(a.matrices[2 * b]);
     d.flex = std::move(a.matrices[2 * b + 1]);
     if (b == 0) {
-      p.statics = std::move(d);
-    } else if (a.tags[b] < 0 || !p.dynamic.emplace(static_cast<int>(a.tags[b]), std::move(d)).second) {
+      e.data.statics = std::move(d);
+    } else if (a.tags[b] < 0 || !e.data.dynamic.emplace(static_cast<int>(a.tags[b]), std::move(d)).second) {
       return std::nullopt;
     }
   }
-  if (!p.fits(k)) return std::nullopt;
-  return p;
+  if (!e.data.fits(k)) return std::nullopt;
+  return e;
 }
 
 contact::PairParameters pair_of(const io::ContactSection& c, const io::ContactElement* e) {
@@ -262,11 +316,18 @@ ForcedModel make_sector_model(Context& ctx) {
   const std::filesystem::path entry = c.directory / ".cache" / ("receptances-" + key + ".bin");
   std::string problem;
   bool reused = false;
+  double force_scale = 1.0;  // the force over the one the entry was computed with
   if (auto arrays = modal::load_arrays(entry, key, &problem)) {
-    if (auto data = unpack(std::move(*arrays), 3 * static_cast<Eigen::Index>(pairs.size()) + 4)) {
-      model.linear =
-          std::make_unique<frf::SectorLinearPart>(std::move(*data), pairs, forcing, sector.sectors(), c.hbm.harmonics);
-      reused = true;
+    if (auto e = unpack(std::move(*arrays), 3 * static_cast<Eigen::Index>(pairs.size()) + 4)) {
+      if (const auto a = force_ratio(forcing.force, e->force)) {
+        force_scale = *a;
+        if (force_scale != 1.0) rescale_excitation(e->data, force_scale);
+        model.linear = std::make_unique<frf::SectorLinearPart>(std::move(e->data), pairs, forcing, sector.sectors(),
+                                                               c.hbm.harmonics);
+        reused = true;
+      } else {
+        problem = "it was computed for a force of another direction";
+      }
     } else {
       problem = "its blocks do not fit this model";
     }
@@ -281,7 +342,7 @@ ForcedModel make_sector_model(Context& ctx) {
     auto part = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, std::cref(factor), pairs, forcing,
                                                         c.hbm.harmonics, ctx.threads);
     try {
-      modal::save_arrays(entry, key, pack(part->precomputed()));
+      modal::save_arrays(entry, key, pack(part->precomputed(), forcing.force));
     } catch (const std::exception& e) {
       ctx.report.warn(std::string("the receptances could not be cached: ") + e.what());
     }
@@ -290,8 +351,11 @@ ForcedModel make_sector_model(Context& ctx) {
   model.sector_pairs = pairs;
   model.sector_forcing = forcing;
   ctx.report.stage("receptances", clock.seconds(), reused);
-  ctx.report.section("frf_model")["receptances"] = {{"cache_entry", entry.string()}, {"reused", reused}};
-  if (reused) log::info("frf: receptances reused from " + entry.string());
+  ctx.report.section("frf_model")["receptances"] = {
+      {"cache_entry", entry.string()}, {"reused", reused}, {"force_scale", force_scale}};
+  if (reused)
+    log::info("frf: receptances reused from " + entry.string() +
+              (force_scale != 1.0 ? " (computed for the force times " + io::format_number(1.0 / force_scale) + ")" : ""));
   if (log::detailed()) {
     const auto& part = static_cast<const frf::SectorLinearPart&>(*model.linear);
     for (const auto& t : part.build_times()) {

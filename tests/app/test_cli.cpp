@@ -540,6 +540,31 @@ TEST(Cli, ReceptancesAreReusedWhereOnlyTheContactLawChangesAndRecomputedWhereThe
   EXPECT_EQ(slurp(s.dir() / "e" / "frf.csv"), slurp(s.dir() / "a" / "frf.csv"));
   const auto [rewritten, rewritten_err] = run("f", "");
   EXPECT_TRUE(rewritten["reused"].get<bool>());
+  // Another excitation level: the data is linear in the force (its excitation row), so the entry
+  // serves it, rescaled; a force of another direction does not.
+  const auto [level, level_err] = run("g", " --set 'excitation.force=[-2.5, -2.5, -2.5]'");
+  EXPECT_TRUE(level["reused"].get<bool>());
+  EXPECT_EQ(level["force_scale"].get<double>(), -2.5);
+  EXPECT_EQ(level["cache_entry"].get<std::string>(), entry.string());
+  const auto [direction, direction_err] = run("h", " --set 'excitation.force=[1.0, 0.0, 0.0]'");
+  EXPECT_FALSE(direction["reused"].get<bool>());
+  EXPECT_NE(direction["cache_entry"].get<std::string>(), entry.string());
+  // The rescaled curve against one whose receptances are computed at that level: the same
+  // largest peak to the solver's tolerance (the rescaled data differs from the computed one in
+  // round-off, which can move the continuation's points, not the peak it locates).
+  for (const auto& e : fs::directory_iterator(entry.parent_path()))
+    if (e.path().filename().string().rfind("receptances-", 0) == 0) fs::remove(e.path());
+  const auto [computed, computed_err] = run("i", " --set 'excitation.force=[-2.5, -2.5, -2.5]'");
+  EXPECT_FALSE(computed["reused"].get<bool>());
+  const auto frf_g = nlohmann::json::parse(slurp(s.dir() / "g" / "run.json"))["frf"];
+  const auto frf_i = nlohmann::json::parse(slurp(s.dir() / "i" / "run.json"))["frf"];
+  const auto frf_a = nlohmann::json::parse(slurp(s.dir() / "a" / "run.json"))["frf"];
+  constexpr double kPeakTol = 1e-6;  // as CliContinuation.TimeRescaledSector...: the corrector's tolerance
+  const double amplitude = frf_i["peak_amplitude_m"], frequency = frf_i["peak_frequency_hz"];
+  EXPECT_NEAR(frf_g["peak_amplitude_m"].get<double>(), amplitude, kPeakTol * amplitude);
+  EXPECT_NEAR(frf_g["peak_frequency_hz"].get<double>(), frequency, kPeakTol * frequency);
+  // and a curve of its own: with friction the response is not proportional to the force.
+  EXPECT_GT(std::abs(amplitude / frf_a["peak_amplitude_m"].get<double>() - 2.5), 1e-3);
 }
 
 }  // namespace
