@@ -354,8 +354,9 @@ ForcedModel make_sector_model(Context& ctx) {
   ctx.report.section("frf_model")["receptances"] = {
       {"cache_entry", entry.string()}, {"reused", reused}, {"force_scale", force_scale}};
   if (reused)
-    log::info("frf: receptances reused from " + entry.string() +
-              (force_scale != 1.0 ? " (computed for the force times " + io::format_number(1.0 / force_scale) + ")" : ""));
+    log::info(
+        "frf: receptances reused from " + entry.string() +
+        (force_scale != 1.0 ? " (computed for the force times " + io::format_number(1.0 / force_scale) + ")" : ""));
   if (log::detailed()) {
     const auto& part = static_cast<const frf::SectorLinearPart&>(*model.linear);
     for (const auto& t : part.build_times()) {
