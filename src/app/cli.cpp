@@ -22,6 +22,7 @@
 #include "io/results_folder.hpp"
 #include "io/schema.hpp"
 #include "mesh/gmsh_module.hpp"
+#include "modal/cache.hpp"
 #include "pipeline/study_stage.hpp"
 
 namespace shroudsim::app {
@@ -35,6 +36,7 @@ struct CommonOptions {
   bool verbose = false;
   int threads = 0;
   bool no_plots = false;
+  double cache_limit_gib = static_cast<double>(modal::kDefaultCacheLimitBytes) / (1ull << 30);
   bool convergence = false;  ///< study only
   bool resume = false;       ///< study only
 };
@@ -48,6 +50,10 @@ void add_common(CLI::App* sub, CommonOptions& o) {
   sub->add_flag("--quiet,-q", o.quiet, "no progress output");
   sub->add_flag("--verbose,-v", o.verbose, "a line per continuation point instead of one progress line");
   sub->add_option("--threads", o.threads, "worker threads (default: all cores)")->check(CLI::Range(0, 1024));
+  sub->add_option("--cache-limit", o.cache_limit_gib,
+                  "GiB kept in the case folder's .cache: after a stage writes an entry, the least recently used "
+                  "ones are deleted down to this (default 10)")
+      ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--no-plots", o.no_plots,
                 "write the result files only: no plotting process is started and no PNG is drawn (the plot's "
                 "Python and matplotlib cost about 0.5 s of a core per command)");
@@ -215,6 +221,7 @@ int run_cli(int argc, char** argv) {
   }
   log::set_verbose(!o.quiet && root);
   log::set_detailed(o.verbose && !o.quiet && root);
+  modal::set_cache_limit(static_cast<std::uintmax_t>(o.cache_limit_gib * static_cast<double>(1ull << 30)));
   log::Stopwatch clock;
 
   Context ctx;

@@ -1,13 +1,20 @@
 #include "modal/cache.hpp"
 
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 
 namespace shroudsim::modal {
 namespace {
@@ -18,6 +25,26 @@ constexpr std::uint64_t kMagicArrays = 0x3253594152524153ull;  // "SARRAYS2"
 
 // Largest cache file read (50 modes of a 240k-DOF sector are about 0.2 GB).
 constexpr std::uintmax_t kMaxCacheBytes = 8ull << 30;
+
+std::atomic<std::uintmax_t> g_cache_limit{kDefaultCacheLimitBytes};
+
+// <kind>-<hex>.bin, kind lowercase letters: what the stages write (mesh-, modes-,
+// receptances-); any other file in the folder is not the cache's to delete.
+bool is_entry_name(const std::string& name) {
+  const auto dash = name.find('-');
+  if (dash == std::string::npos || dash == 0 || name.size() < dash + 6 || !name.ends_with(".bin")) return false;
+  for (std::size_t i = 0; i < dash; ++i)
+    if (name[i] < 'a' || name[i] > 'z') return false;
+  for (std::size_t i = dash + 1; i < name.size() - 4; ++i)
+    if (!std::isxdigit(static_cast<unsigned char>(name[i]))) return false;
+  return true;
+}
+
+// A temporary file of write_atomic: <entry name>.tmp<digits>.
+bool is_temporary_name(const std::string& name) {
+  const auto at = name.find(".bin.tmp");
+  return at != std::string::npos && is_entry_name(name.substr(0, at + 4));
+}
 
 // FNV-1a, 64 bit, over the whole entry before the checksum.
 std::uint64_t checksum(const char* data, std::size_t n) {
@@ -72,6 +99,7 @@ void write_atomic(const std::filesystem::path& path, std::uint64_t magic, const 
     if (!out) throw std::runtime_error("cannot write cache file " + tmp);
   }
   std::filesystem::rename(tmp, path);
+  trim_cache(path.parent_path(), g_cache_limit.load(), path);
 }
 
 // Reads an entry; on success `in` is positioned at the payload. Absent: nullopt without a
@@ -111,6 +139,8 @@ std::optional<std::istringstream> read_entry(const std::filesystem::path& path, 
   if (!get(in, n) || n != static_cast<std::int64_t>(key.size())) return fail("written under another key");
   std::string k(key.size(), '\0');
   if (!in.read(k.data(), static_cast<std::streamsize>(k.size())) || k != key) return fail("written under another key");
+  // Used now: the last an entry is trimmed (trim_cache goes by the modification time).
+  std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(), ec);
   return in;
 }
 
@@ -293,6 +323,58 @@ std::optional<TaggedArrays> load_arrays(const std::filesystem::path& path, const
   for (auto& m : a.matrices)
     if (!get_matrix(*in, m, kMaxEntries) || !m.allFinite()) return bad();
   return a;
+}
+
+void set_cache_limit(std::uintmax_t bytes) { g_cache_limit.store(bytes); }
+
+std::uintmax_t cache_limit() { return g_cache_limit.load(); }
+
+int trim_cache(const std::filesystem::path& dir, std::uintmax_t limit, const std::filesystem::path& keep) {
+  namespace fs = std::filesystem;
+  using Entry = std::tuple<fs::file_time_type, fs::path, std::uintmax_t>;
+  std::vector<Entry> entries;
+  std::uintmax_t total = 0;
+  std::error_code ec;
+  const auto now = fs::file_time_type::clock::now();
+  int deleted = 0;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::error_code e;
+    if (!it->is_regular_file(e) || e) continue;
+    const auto time = it->last_write_time(e);
+    if (e) continue;
+    if (is_temporary_name(name)) {  // an interrupted write's leftover
+      if (now - time > std::chrono::hours(1) && fs::remove(it->path(), e)) ++deleted;
+      continue;
+    }
+    if (!is_entry_name(name)) continue;
+    const std::uintmax_t size = it->file_size(e);
+    if (e) continue;
+    total += size;
+    if (!fs::equivalent(it->path(), keep, e)) entries.emplace_back(time, it->path(), size);
+  }
+  if (total <= limit) return deleted;
+  std::sort(entries.begin(), entries.end());  // least recently used first
+  std::uintmax_t freed = 0;
+  int evicted = 0;
+  for (const auto& [time, path, size] : entries) {
+    if (total <= limit) break;
+    std::error_code e;
+    if (fs::remove(path, e)) {
+      ++evicted;
+      freed += size;
+    }
+    total -= size;  // gone either way (another process may have deleted it)
+  }
+  if (evicted > 0) {
+    std::ostringstream m;
+    m << std::setprecision(3) << "cache: deleted the " << evicted << " least recently used "
+      << (evicted == 1 ? "entry" : "entries") << " of " << dir.string() << " ("
+      << static_cast<double>(freed) / (1 << 20) << " MiB) to keep it within " << static_cast<double>(limit) / (1 << 20)
+      << " MiB (--cache-limit)";
+    log::info(m.str());
+  }
+  return deleted + evicted;
 }
 
 }  // namespace shroudsim::modal

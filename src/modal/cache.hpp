@@ -44,4 +44,17 @@ void save_arrays(const std::filesystem::path& path, const std::string& key, cons
 std::optional<TaggedArrays> load_arrays(const std::filesystem::path& path, const std::string& key,
                                         std::string* problem = nullptr);
 
+/// The bound on a cache folder's entries (files named <kind>-<hex key>.bin): after an entry is
+/// written, the least recently used of its folder's entries (used: written or read with its
+/// key) are deleted until they total at most this many bytes; the entry just written is kept
+/// even when it alone is larger. Temporary files of an interrupted write older than an hour
+/// go too. Process-wide: the command line's --cache-limit (docs/contract.md), default
+/// kDefaultCacheLimitBytes.
+constexpr std::uintmax_t kDefaultCacheLimitBytes = 10ull << 30;
+void set_cache_limit(std::uintmax_t bytes);
+std::uintmax_t cache_limit();
+/// Trims `dir` to `limit` bytes of entries as above, never deleting `keep`; returns the
+/// number of entries deleted. A file another process deletes meanwhile is skipped.
+int trim_cache(const std::filesystem::path& dir, std::uintmax_t limit, const std::filesystem::path& keep);
+
 }  // namespace shroudsim::modal

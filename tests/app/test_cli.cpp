@@ -567,5 +567,22 @@ TEST(Cli, ReceptancesAreReusedWhereOnlyTheContactLawChangesAndRecomputedWhereThe
   EXPECT_GT(std::abs(amplitude / frf_a["peak_amplitude_m"].get<double>() - 2.5), 1e-3);
 }
 
+TEST(Cli, CacheLimitBoundsTheCaseFolderCache) {
+  // --cache-limit 0 keeps only the entry written last (the receptances, after the mesh and
+  // the modes of three harmonic indices); a negative bound is refused before any work.
+  const Scratch s("cache_limit");
+  s.write("case.toml", coarse_sector_case(95.0, 96.0));
+  const CliResult r = s.run("frf case.toml --quiet --no-plots --cache-limit 0 --out a");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> entries;
+  for (const auto& e : fs::directory_iterator(s.dir() / ".cache")) entries.push_back(e.path().filename().string());
+  ASSERT_EQ(entries.size(), 1u);
+  EXPECT_EQ(entries[0].rfind("receptances-", 0), 0u) << entries[0];
+  const CliResult bad = s.run("frf case.toml --quiet --cache-limit -1 --out b");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--cache-limit"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(s.dir() / "b"));
+}
+
 }  // namespace
 }  // namespace shroudsim::testing

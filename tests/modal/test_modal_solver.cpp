@@ -1,6 +1,9 @@
 // Shift-invert Lanczos (Spectra + CHOLMOD) against dense reference spectra; the complex
 // 2n embedding returns each mode once, mass-normalised; failures are reported.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
 
 #include <fstream>
 #include <iterator>
@@ -387,6 +390,53 @@ TEST(ModalCache, CorruptedBytesAreDetectedAtEveryOffset) {
   }
   EXPECT_EQ(checked, 64);
   std::filesystem::remove_all(dir);
+}
+
+// The cache folder is kept within its bound: after a write the least recently used entries go
+// (a read is a use), never the entry just written nor a file that is not an entry; an
+// interrupted write's leftover goes once it is an hour old, a write in progress stays.
+TEST(ModalCache, IsTrimmedToItsLimitByLeastRecentUse) {
+  namespace fs = std::filesystem;
+  using std::chrono::minutes;
+  const auto dir = fs::temp_directory_path() / ("shroudsim_cache_trim_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const std::uintmax_t limit_before = cache_limit();
+  TaggedArrays a;
+  a.tags = {0};
+  a.vectors = {Eigen::VectorXd::Ones(12'500)};  // about 100 kB an entry
+  auto name = [](int i) { return "receptances-000000000000000" + std::to_string(i) + ".bin"; };
+  const auto now = fs::file_time_type::clock::now();
+  set_cache_limit(std::uintmax_t{1} << 40);  // nothing trimmed while the folder is set up
+  for (int i = 0; i < 4; ++i) {              // entries 0..3, last used 40, 30, 20, 10 minutes ago
+    save_arrays(dir / name(i), "k", a);
+    fs::last_write_time(dir / name(i), now - minutes(40 - 10 * i));
+  }
+  const std::uintmax_t entry = fs::file_size(dir / name(0));
+  std::ofstream(dir / "notes.txt") << "not an entry";
+  std::ofstream(dir / (name(7) + ".tmp123")) << "an interrupted write";
+  fs::last_write_time(dir / (name(7) + ".tmp123"), now - minutes(120));
+  std::ofstream(dir / (name(8) + ".tmp456")) << "a write in progress";
+  ASSERT_TRUE(load_arrays(dir / name(0), "k").has_value());  // entry 0 used now
+  // Room for three and a half entries: writing a fifth deletes the two least recently used.
+  set_cache_limit(3 * entry + entry / 2);
+  save_arrays(dir / name(4), "k", a);
+  EXPECT_TRUE(fs::exists(dir / name(0)));
+  EXPECT_FALSE(fs::exists(dir / name(1)));
+  EXPECT_FALSE(fs::exists(dir / name(2)));
+  EXPECT_TRUE(fs::exists(dir / name(3)));
+  EXPECT_TRUE(fs::exists(dir / name(4)));
+  EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+  EXPECT_FALSE(fs::exists(dir / (name(7) + ".tmp123")));
+  EXPECT_TRUE(fs::exists(dir / (name(8) + ".tmp456")));
+  // A bound below one entry keeps only the entry just written.
+  set_cache_limit(0);
+  save_arrays(dir / name(5), "k", a);
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir)) entries += e.path().extension() == ".bin";
+  EXPECT_EQ(entries, 1);
+  EXPECT_TRUE(fs::exists(dir / name(5)));
+  set_cache_limit(limit_before);
+  fs::remove_all(dir);
 }
 
 }  // namespace
