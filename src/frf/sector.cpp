@@ -230,6 +230,19 @@ bool SectorLinearPart::Precomputed::fits(Eigen::Index k) const {
   return true;
 }
 
+void SectorLinearPart::scale_force(double a, const Eigen::Vector3d& force) {
+  const Eigen::Index e = n_contact() + 3;  // the excitation row
+  auto scale = [&](IndexData& d) {
+    if (d.psi.rows() > e) d.psi.row(e) *= a;
+    d.flex.row(e) *= a;
+    d.flex.col(e) *= a;
+  };
+  scale(static_);
+  for (auto& [h, d] : dynamic_) scale(d);
+  for (auto& [h, y] : solutions_) y.col(e) *= a;
+  forcing_.force = force;
+}
+
 const Eigen::MatrixXcd* SectorLinearPart::static_solution(int h, bool& conjugated) const {
   conjugated = false;
   if (auto it = solutions_.find(h); it != solutions_.end()) return &it->second;

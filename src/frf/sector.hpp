@@ -153,6 +153,11 @@ class SectorLinearPart : public LinearPart {
   /// static solution is kept (static_solution() is nullptr: the shapes factorize).
   SectorLinearPart(Precomputed data, std::vector<SectorContactPair> pairs, SectorForcing forcing, int sectors,
                    int n_harmonics);
+  /// The model for the force a times the one it was built with, given as `force`: the data is
+  /// linear in the force (the excitation row of C_h), so the excitation row and column of every
+  /// block's psi and flex (flex(k - 1, k - 1) by a^2) and the excitation column of the kept
+  /// static solutions are multiplied by a, and `force` replaces the forcing's force.
+  void scale_force(double a, const Eigen::Vector3d& force);
 
  private:
   /// Q_n(W) (k x k).

@@ -3,7 +3,6 @@
 // response nodes (docs/physics.md sections 2 and 3).
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -35,55 +34,33 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-// The excitation row of the receptance data (row c + 3 of C_h, docs/physics.md section 3) is the
-// force times the excitation node's rows, so the data is linear in the force: an entry serves any
-// multiple of the force it was computed with, rescaled (rescale_excitation). The key holds the
-// force's direction only: the force over its largest component (1 there exactly, whatever the
-// multiple), rounded to 2^-40; zero for no force.
-std::array<std::int64_t, 3> force_direction(const Eigen::Vector3d& f) {
-  std::array<std::int64_t, 3> d{0, 0, 0};
-  Eigen::Index largest = 0;
-  if (f.cwiseAbs().maxCoeff(&largest) == 0.0) return d;
-  for (int a = 0; a < 3; ++a) d[static_cast<std::size_t>(a)] = std::llround(std::ldexp(f[a] / f[largest], 40));
-  return d;
-}
+// The force as a size times a direction, the force over its component of largest magnitude:
+// 1 there, and the same bits for every multiple whose division is exact ([1, 1, 1] for
+// [2.5, 2.5, 2.5] and for [-1, -1, -1]). No force: direction zero, size 1. The receptance data
+// is computed for the direction and then scaled by the size (frf::SectorLinearPart::
+// scale_force), whether the run computes it or reads it from the cache: so a run's curve does
+// not depend on which excitation level computed the entry it reads.
+struct ForceParts {
+  Eigen::Vector3d direction;
+  double size = 1.0;
+};
 
-// The factor a with force = a * computed_with, or nullopt when the two are not parallel (to
-// 1e-12 of the force: the rounding of force_direction) or one of them is zero and the other not.
-std::optional<double> force_ratio(const Eigen::Vector3d& force, const Eigen::Vector3d& computed_with) {
-  constexpr double kParallel = 1e-12;
-  if (force == computed_with) return 1.0;  // the same entry: the data as computed, bit for bit
+ForceParts force_parts(const Eigen::Vector3d& f) {
   Eigen::Index largest = 0;
-  if (computed_with.cwiseAbs().maxCoeff(&largest) == 0.0 || force.isZero(0.0)) return std::nullopt;
-  const double a = force[largest] / computed_with[largest];
-  if ((force - a * computed_with).norm() > kParallel * force.norm()) return std::nullopt;
-  return a;
-}
-
-// The data for the force a times the one it was computed with: the excitation row and column
-// (the last, k - 1) of every block's psi and flex scaled by a (flex(k - 1, k - 1) by a^2, as
-// C_h K_h^-1 C_h^H has it).
-void rescale_excitation(frf::SectorLinearPart::Precomputed& p, double a) {
-  auto scale = [a](frf::SectorLinearPart::IndexData& d) {
-    const Eigen::Index e = d.flex.rows() - 1;
-    if (d.psi.rows() == d.flex.rows()) d.psi.row(e) *= a;
-    d.flex.row(e) *= a;
-    d.flex.col(e) *= a;
-  };
-  scale(p.statics);
-  for (auto& [h, d] : p.dynamic) scale(d);
+  if (f.cwiseAbs().maxCoeff(&largest) == 0.0) return {Eigen::Vector3d::Zero(), 1.0};
+  return {f / f[largest], f[largest]};
 }
 
 // The fingerprint of everything the sector's receptance data depends on (frf::SectorLinearPart::
 // Precomputed): the sector (mesh, its K and M as used, the tied shroud springs), the modes
 // themselves, the contact rows (pairs, frames, patches), the forcing rows (response and
-// excitation nodes, the force's direction: force_direction), the harmonic indices and the
+// excitation nodes, the force: its direction, force_parts), the harmonic indices and the
 // factorization method (its round-off). Not the contact law, the damping, the frequencies or the
 // force's size.
 std::string receptances_key(const ModalModel& modal, const std::vector<frf::SectorContactPair>& pairs,
                             const frf::SectorForcing& forcing, int n_harmonics) {
   fe::Hasher h;
-  h.add(std::string("receptances 2"));
+  h.add(std::string("receptances 3"));
   fe::hash_into(h, modal.mesh);
   for (const auto* a : {&modal.km.K, &modal.km.M}) {
     SHROUDSIM_CHECK(a->isCompressed(), "K and M compressed");
@@ -122,7 +99,7 @@ std::string receptances_key(const ModalModel& modal, const std::vector<frf::Sect
   }
   h.add(forcing.engine_order);
   h.add(forcing.excitation_node);
-  h.add(force_direction(forcing.force));
+  h.add_bytes(forcing.force.data(), sizeof(double) * 3);
   h.add(forcing.response_node);
   h.add(static_cast<int>(forcing.residual_flexibility));
   h.add(n_harmonics);
@@ -131,7 +108,7 @@ std::string receptances_key(const ModalModel& modal, const std::vector<frf::Sect
 
 // The cache entry of the receptance data: per block (the static one tagged -1, then each
 // harmonic index) omega as a vector, psi and flex as matrices; last, tagged -2, the force the
-// data was computed with (a vector, no matrices).
+// data was computed with (its direction, force_parts; a vector, no matrices).
 constexpr std::int64_t kStaticTag = -1, kForceTag = -2;
 
 modal::TaggedArrays pack(const frf::SectorLinearPart::Precomputed& p, const Eigen::Vector3d& force) {
@@ -311,27 +288,26 @@ ForcedModel make_sector_model(Context& ctx) {
   const cyclic::CyclicSector& sector = modal.cyclic();
   // The receptance data is reused from the case directory's cache when everything it depends
   // on is unchanged (receptances_key): a run that changes only the contact law, N, the damping,
-  // the range or the continuation factorizes nothing (docs/contract.md, frf_model.receptances).
-  const std::string key = receptances_key(modal, pairs, forcing, c.hbm.harmonics);
+  // the range, the continuation or the size of the force factorizes nothing (docs/contract.md,
+  // frf_model.receptances). It is that of the force's direction, scaled (force_parts).
+  const ForceParts force = force_parts(forcing.force);
+  frf::SectorForcing unit = forcing;
+  unit.force = force.direction;
+  const std::string key = receptances_key(modal, pairs, unit, c.hbm.harmonics);
   const std::filesystem::path entry = c.directory / ".cache" / ("receptances-" + key + ".bin");
   std::string problem;
-  bool reused = false;
-  double force_scale = 1.0;  // the force over the one the entry was computed with
+  std::unique_ptr<frf::SectorLinearPart> part;
   if (auto arrays = modal::load_arrays(entry, key, &problem)) {
     if (auto e = unpack(std::move(*arrays), 3 * static_cast<Eigen::Index>(pairs.size()) + 4)) {
-      if (const auto a = force_ratio(forcing.force, e->force)) {
-        force_scale = *a;
-        if (force_scale != 1.0) rescale_excitation(e->data, force_scale);
-        model.linear = std::make_unique<frf::SectorLinearPart>(std::move(e->data), pairs, forcing, sector.sectors(),
-                                                               c.hbm.harmonics);
-        reused = true;
-      } else {
-        problem = "it was computed for a force of another direction";
-      }
+      if (e->force == force.direction)
+        part =
+            std::make_unique<frf::SectorLinearPart>(std::move(e->data), pairs, unit, sector.sectors(), c.hbm.harmonics);
+      else problem = "it was computed for another force";
     } else {
       problem = "its blocks do not fit this model";
     }
   }
+  const bool reused = part != nullptr;
   if (!problem.empty())
     ctx.report.warn("the cache entry " + entry.string() + " is not used (" + problem + "); recomputing it");
   if (!reused) {
@@ -339,24 +315,22 @@ ForcedModel make_sector_model(Context& ctx) {
     // as long as its job, so that at most one per worker is held (a map of them kept every factor
     // until the stage ended: up to five of the 238k-DOF sector's at once).
     const modal::HarmonicStiffnessFactors factor(sector, modal.options.factor_method);  // one symbolic analysis
-    auto part = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, std::cref(factor), pairs, forcing,
-                                                        c.hbm.harmonics, ctx.threads);
+    part = std::make_unique<frf::SectorLinearPart>(sector, modal.bases, std::cref(factor), pairs, unit, c.hbm.harmonics,
+                                                   ctx.threads);
     try {
-      modal::save_arrays(entry, key, pack(part->precomputed(), forcing.force));
+      modal::save_arrays(entry, key, pack(part->precomputed(), force.direction));
     } catch (const std::exception& e) {
       ctx.report.warn(std::string("the receptances could not be cached: ") + e.what());
     }
-    model.linear = std::move(part);
   }
+  if (force.size != 1.0) part->scale_force(force.size, forcing.force);
+  model.linear = std::move(part);
   model.sector_pairs = pairs;
   model.sector_forcing = forcing;
   ctx.report.stage("receptances", clock.seconds(), reused);
   ctx.report.section("frf_model")["receptances"] = {
-      {"cache_entry", entry.string()}, {"reused", reused}, {"force_scale", force_scale}};
-  if (reused)
-    log::info(
-        "frf: receptances reused from " + entry.string() +
-        (force_scale != 1.0 ? " (computed for the force times " + io::format_number(1.0 / force_scale) + ")" : ""));
+      {"cache_entry", entry.string()}, {"reused", reused}, {"force_scale", force.size}};
+  if (reused) log::info("frf: receptances reused from " + entry.string());
   if (log::detailed()) {
     const auto& part = static_cast<const frf::SectorLinearPart&>(*model.linear);
     for (const auto& t : part.build_times()) {

@@ -129,6 +129,70 @@ TEST(SectorReceptance, ModalSumWithResidualFlexibilityMatchesTheDirectSolve) {
   }
 }
 
+// The receptance data is linear in the force (its excitation row): a part built for f and
+// scaled by a (scale_force, what a cache entry of another excitation level gets) has the data,
+// receptances and kept static solutions of a part built for a f, to round-off.
+TEST(SectorReceptance, ScalingTheForceIsBuildingWithTheScaledForce) {
+  const Fixture f;
+  const std::vector<SectorContactPair> pairs = some_pairs(f, 3, 2, 0.3, 0.2, Eigen::Vector3d(1, 2, 3));
+  SectorForcing forcing;
+  forcing.engine_order = 3;
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  forcing.damping_ratio = 0.01;
+  modal::ModalOptions mo;
+  mo.modes = 10;
+  std::map<int, modal::ModalBasis> bases;
+  for (int h : {0, 3, 6}) {
+    auto r = modal::solve_harmonic(*f.sector, h, mo);
+    ASSERT_TRUE(r.report.ok()) << r.report.message;
+    bases[h] = r.basis;
+  }
+  auto factor = [&](int h) { return modal::factor_harmonic_stiffness(*f.sector, h); };
+  constexpr double a = -2.5;
+  SectorForcing scaled = forcing;
+  scaled.force = a * forcing.force;
+  SectorLinearPart part(*f.sector, bases, factor, pairs, forcing, 2);
+  const SectorLinearPart direct_part(*f.sector, bases, factor, pairs, scaled, 2);
+  part.scale_force(a, scaled.force);
+  constexpr double kRoundOff = 1e-12;  // relative: the same solves, a real factor applied after
+  auto near = [&](const Eigen::MatrixXcd& x, const Eigen::MatrixXcd& y, const std::string& what) {
+    ASSERT_EQ(x.rows(), y.rows()) << what;
+    ASSERT_EQ(x.cols(), y.cols()) << what;
+    EXPECT_LE((x - y).norm(), kRoundOff * y.norm()) << what;
+  };
+  const auto p = part.precomputed(), q = direct_part.precomputed();
+  near(p.statics.flex, q.statics.flex, "static flexibility");
+  ASSERT_EQ(p.dynamic.size(), q.dynamic.size());
+  for (const auto& [h, d] : q.dynamic) {
+    near(p.dynamic.at(h).psi, d.psi, "psi of index " + std::to_string(h));
+    near(p.dynamic.at(h).flex, d.flex, "flex of index " + std::to_string(h));
+  }
+  const double w = 0.7 * bases.at(3).omega[0];
+  for (int n : {0, 1, 2}) {
+    HarmonicReceptance r1, r2;
+    part.harmonic(n, w, r1);
+    direct_part.harmonic(n, w, r2);
+    near(r1.G, r2.G, "G_" + std::to_string(n));
+    near(r1.w_lin, r2.w_lin, "w_lin_" + std::to_string(n));
+    near(r1.u_lin, r2.u_lin, "u_lin_" + std::to_string(n));
+  }
+  // The excitation moves with a: harmonic 1's free motion is a times the unscaled one's.
+  const SectorLinearPart unscaled(*f.sector, bases, factor, pairs, forcing, 2);
+  HarmonicReceptance r0, r1;
+  unscaled.harmonic(1, w, r0);
+  part.harmonic(1, w, r1);
+  near(r1.w_lin, a * r0.w_lin, "w_lin scales with the force");
+  for (int h : {0, 3}) {
+    bool c1 = false, c2 = false;
+    const Eigen::MatrixXcd* y1 = part.static_solution(h, c1);
+    const Eigen::MatrixXcd* y2 = direct_part.static_solution(h, c2);
+    ASSERT_TRUE(y1 && y2) << "the coarse sector keeps its static solutions";
+    near(*y1, *y2, "static solution of index " + std::to_string(h));
+  }
+}
+
 /// The shapes tests' forcing: excitation and response at two interior nodes.
 SectorForcing shape_forcing(const Fixture& f, int engine_order) {
   SectorForcing forcing;
