@@ -15,6 +15,7 @@
 #include "forced/excitation_homotopy.hpp"
 #include "forced/time_march.hpp"
 #include "frf/lumped.hpp"
+#include "linalg/parallel.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -760,6 +761,7 @@ namespace {
 
 // The results of every point (energy balance polished where it misses) and the located peaks.
 void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSettings& settings,
+                              const ForcedModel& model, const hbm::ContactEvaluatorOptions& eo,
                               ReducedEquations& equations, const continuation::ArclengthOptions& ao) {
   for (auto& p : out.points) {
     out.results.push_back(equations.analyse(p.x, p.lambda));
@@ -785,8 +787,22 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
     }
   }
 
-  // Resonance peaks, located along the branch.
+  // Resonance peaks, located along the branch: every prominent sampled maximum first, each
+  // with equations of its own (a fresh evaluator and preconditioner: its result does not
+  // depend on the order, the worker count or what was solved before it), on up to `threads`
+  // workers; then in order, skipping tops located before.
   const auto t0 = std::chrono::steady_clock::now();
+  struct Candidate {
+    std::size_t i = 0, m = 0;  // the point, its place in the piece
+    int piece = 0;
+    bool inner = false;  // with a point on either side in its piece
+    std::array<const continuation::BranchPoint*, 3> pts{};
+    std::array<double, 3> amp{};
+    continuation::Extremum best;
+    int evaluations = 0;
+    SolverStatistics statistics;
+  };
+  std::vector<Candidate> candidates;
   const int n_pieces = piece_count(out);
   for (int pc = 0; pc < n_pieces; ++pc) {
     std::vector<std::size_t> idx;
@@ -795,73 +811,91 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
       if (out.piece[i] == pc) idx.push_back(i), amp.push_back(out.results[i].amplitude);
     constexpr double kMinProminence = 0.02;  // a local maximum 2 % above its surroundings
     for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
-      const std::size_t i = idx[m];
-      ResponsePeak peak{out.points[i].lambda, out.results[i].amplitude, i, pc, false, out.points[i].x};
-      const bool inner = m > 0 && m + 1 < idx.size();
-      // The sampled maximum with the points beside it (inner maxima only).
-      std::array<const continuation::BranchPoint*, 3> pts{};
-      if (inner) {
-        pts = {&out.points[idx[m - 1]], &out.points[i], &out.points[idx[m + 1]]};
-        // A top the curve has already passed over and located (a piece that turns back over
-        // it, or an earlier piece that overlaps this one): not located again.
-        // The geometric test picks the candidates; the corrector confirms that the located peak
-        // is a solution of the branch these three points sample (a twin branch a sample away
-        // stays at its own distance), as closes_loop does for a closed loop.
-        constexpr double kSameBranchTolerance = 100.0;  // in units of the tracing tolerance
-        const bool copy = std::any_of(out.peaks.begin(), out.peaks.end(), [&](const ResponsePeak& q) {
-          if (!is_sampled_top(q, pts, out.results[i].amplitude, ao.x_scale, ao.lambda_scale)) return false;
-          continuation::BranchPoint located;
-          located.x = q.x;
-          located.lambda = q.frequency_hz;
-          const std::vector<continuation::BranchPoint> sampled{*pts[0], *pts[1], *pts[2]};
-          return continuation::distance_to_branch(equations, ao, sampled, located) <=
-                 kSameBranchTolerance * ao.tolerance;
-        });
-        if (copy) continue;
+      Candidate cd;
+      cd.i = idx[m];
+      cd.m = m;
+      cd.piece = pc;
+      cd.inner = m > 0 && m + 1 < idx.size();
+      if (cd.inner) {
+        cd.pts = {&out.points[idx[m - 1]], &out.points[cd.i], &out.points[idx[m + 1]]};
+        cd.amp = {out.results[idx[m - 1]].amplitude, out.results[cd.i].amplitude, out.results[idx[m + 1]].amplitude};
       }
-      if (settings.locate_peaks && inner) {
-        int evaluations = 0;
-        continuation::ScaledSystem sys(equations, ao, &evaluations);
-        continuation::ArclengthOptions fine = ao;
-        const double own = out.points[i].x.lpNorm<Eigen::Infinity>();
-        const double unit = ao.x_scale.size() > 0 ? ao.x_scale.maxCoeff() : 1.0;
-        if (own > 0 && unit > 0) fine.tolerance = std::min(ao.tolerance, kPeakTolerance * own / unit);
-        const Amplitude amplitude = [&](const Eigen::VectorXd& x, double lambda) {
-          return equations.analyse(x, lambda).amplitude;
-        };
-        // On the two steps beside the sampled maximum, each parametrized by the arclength
-        // along the tangent of its first point.
-        std::array<double, 2> lengths{0.0, 0.0};
-        continuation::Extremum best;
-        int found_evaluations = 0;
-        for (int k = 0; k < 2; ++k) {
-          const continuation::BranchPoint& p = *pts[k];
-          const continuation::BranchPoint& q = *pts[k + 1];
-          lengths[k] = p.tangent.dot(sys.to_scaled(q.x, q.lambda) - sys.to_scaled(p.x, p.lambda));
-          if (!(lengths[k] > 0)) continue;
-          // At the tight tolerance; where the corrector cannot reach it, at the tracing one.
-          continuation::Extremum e = continuation::locate_maximum(equations, fine, p, lengths[k], amplitude);
-          found_evaluations += e.evaluations;
-          if (!e.found) {
-            e = continuation::locate_maximum(equations, ao, p, lengths[k], amplitude);
-            found_evaluations += e.evaluations;
-          }
-          keep_larger(best, e);
-        }
-        if (best.found)
-          best = search_rippled_top(
-              equations, fine, ao, pts,
-              {out.results[idx[m - 1]].amplitude, out.results[i].amplitude, out.results[idx[m + 1]].amplitude}, lengths,
-              best, amplitude, found_evaluations);
-        out.summary.residual_evaluations += found_evaluations;
-        if (best.found) {
-          peak.located = true;  // if no trial point beats the sampled one, it is the maximum to tolerance
-          if (best.value > peak.amplitude_m)
-            peak.amplitude_m = best.value, peak.frequency_hz = best.lambda, peak.x = best.x;
-        }
-      }
-      out.peaks.push_back(peak);
+      candidates.push_back(cd);
     }
+  }
+  auto locate = [&](Candidate& cd) {
+    hbm::ContactEvaluator evaluator(eo, model.pairs);
+    ReducedEquations own(*model.linear, evaluator);
+    own.set_linear_solver(equations.linear_solver());
+    own.set_excitation_scale(equations.excitation_scale());
+    int evaluations = 0;
+    continuation::ScaledSystem sys(own, ao, &evaluations);
+    continuation::ArclengthOptions fine = ao;
+    const double size = out.points[cd.i].x.lpNorm<Eigen::Infinity>();
+    const double unit = ao.x_scale.size() > 0 ? ao.x_scale.maxCoeff() : 1.0;
+    if (size > 0 && unit > 0) fine.tolerance = std::min(ao.tolerance, kPeakTolerance * size / unit);
+    const Amplitude amplitude = [&](const Eigen::VectorXd& x, double lambda) {
+      return own.analyse(x, lambda).amplitude;
+    };
+    // On the two steps beside the sampled maximum, each parametrized by the arclength along
+    // the tangent of its first point.
+    std::array<double, 2> lengths{0.0, 0.0};
+    for (int k = 0; k < 2; ++k) {
+      const continuation::BranchPoint& p = *cd.pts[k];
+      const continuation::BranchPoint& q = *cd.pts[k + 1];
+      lengths[k] = p.tangent.dot(sys.to_scaled(q.x, q.lambda) - sys.to_scaled(p.x, p.lambda));
+      if (!(lengths[k] > 0)) continue;
+      // At the tight tolerance; where the corrector cannot reach it, at the tracing one.
+      continuation::Extremum e = continuation::locate_maximum(own, fine, p, lengths[k], amplitude);
+      cd.evaluations += e.evaluations;
+      if (!e.found) {
+        e = continuation::locate_maximum(own, ao, p, lengths[k], amplitude);
+        cd.evaluations += e.evaluations;
+      }
+      keep_larger(cd.best, e);
+    }
+    if (cd.best.found)
+      cd.best = search_rippled_top(own, fine, ao, cd.pts, cd.amp, lengths, cd.best, amplitude, cd.evaluations);
+    cd.statistics = own.statistics();
+  };
+  std::vector<std::size_t> to_locate;
+  if (settings.locate_peaks)
+    for (std::size_t k = 0; k < candidates.size(); ++k)
+      if (candidates[k].inner) to_locate.push_back(k);
+  // The tallest first: its top is the most rippled, the longest job (the results do not depend
+  // on the order).
+  std::stable_sort(to_locate.begin(), to_locate.end(),
+                   [&](std::size_t a, std::size_t b) { return candidates[a].amp[1] > candidates[b].amp[1]; });
+  const int jobs = static_cast<int>(to_locate.size());
+  linalg::parallel_for(jobs, linalg::worker_count(eo.threads, jobs),
+                       [&](int j) { locate(candidates[to_locate[static_cast<std::size_t>(j)]]); });
+  for (const Candidate& cd : candidates) {
+    ResponsePeak peak{out.points[cd.i].lambda, out.results[cd.i].amplitude, cd.i, cd.piece, false, out.points[cd.i].x};
+    out.summary.residual_evaluations += cd.evaluations;
+    equations.add_statistics(cd.statistics);
+    if (cd.inner) {
+      // A top the curve has already passed over and located (a piece that turns back over
+      // it, or an earlier piece that overlaps this one): not reported again.
+      // The geometric test picks the candidates; the corrector confirms that the located peak
+      // is a solution of the branch these three points sample (a twin branch a sample away
+      // stays at its own distance), as closes_loop does for a closed loop.
+      constexpr double kSameBranchTolerance = 100.0;  // in units of the tracing tolerance
+      const bool copy = std::any_of(out.peaks.begin(), out.peaks.end(), [&](const ResponsePeak& q) {
+        if (!is_sampled_top(q, cd.pts, out.results[cd.i].amplitude, ao.x_scale, ao.lambda_scale)) return false;
+        continuation::BranchPoint located;
+        located.x = q.x;
+        located.lambda = q.frequency_hz;
+        const std::vector<continuation::BranchPoint> sampled{*cd.pts[0], *cd.pts[1], *cd.pts[2]};
+        return continuation::distance_to_branch(equations, ao, sampled, located) <= kSameBranchTolerance * ao.tolerance;
+      });
+      if (copy) continue;
+    }
+    if (cd.best.found) {
+      peak.located = true;  // if no trial point beats the sampled one, it is the maximum to tolerance
+      if (cd.best.value > peak.amplitude_m)
+        peak.amplitude_m = cd.best.value, peak.frequency_hz = cd.best.lambda, peak.x = cd.best.x;
+    }
+    out.peaks.push_back(peak);
   }
   out.peaks = distinct_peaks(std::move(out.peaks), ao.lambda_scale);
   out.peak_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -930,7 +964,7 @@ FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const Fo
         out.summary.status = continuation::BranchStatus::kReachedEnd;
         out.warnings.push_back("no start at either end of the range; the curve was traced from inside it: " + notes +
                                (joined ? "" : " (not all shown to be one branch)") + " (frf.csv column `piece`)");
-        analyse_and_locate_peaks(out, settings, equations, ao);
+        analyse_and_locate_peaks(out, settings, model, eo, equations, ao);
         return out;
       }
       both += "; inside the range: " + notes;
@@ -940,7 +974,7 @@ FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const Fo
         out.pieces_join = false;
         out.two_pieces = true;
         out.summary.message = both;
-        analyse_and_locate_peaks(out, settings, equations, ao);
+        analyse_and_locate_peaks(out, settings, model, eo, equations, ao);
         return out;
       }
       if (dynamic_cast<const NoPeriodicMotion*>(&e) && dynamic_cast<const NoPeriodicMotion*>(&e2))
@@ -1112,7 +1146,7 @@ FrequencyResponse trace_from(const FrequencyResponseSettings& settings, const Fo
   }
   hop_if_uncovered(out, model, eo, equations, ao, progress, info);
 
-  analyse_and_locate_peaks(out, settings, equations, ao);
+  analyse_and_locate_peaks(out, settings, model, eo, equations, ao);
   return out;
 }
 

@@ -117,6 +117,9 @@ class ReducedEquations : public continuation::ParametricResidual {
   }
   const LinearSolverOptions& linear_solver() const { return solver_; }
   const SolverStatistics& statistics() const { return stats_; }
+  /// Adds another object's statistics (equations of the same model that solved part of the
+  /// work, e.g. a peak's location) to these.
+  void add_statistics(const SolverStatistics& s);
   /// The Jacobian I + G(f) D formed densely the plain way (G as a dense n x n real matrix times
   /// the block-diagonal D): the reference the structured product is tested against.
   Eigen::MatrixXd dense_jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks) const;
