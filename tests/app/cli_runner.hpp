@@ -72,4 +72,27 @@ class Scratch {
   std::filesystem::path dir_;
 };
 
+// A coarse sector (4-node tets, 10 modes per index), 3 shroud pairs, full3d contact, H = 3,
+// N = 64, traced from f0 to f1 Hz.
+inline std::string coarse_sector_case(double f0, double f1) {
+  std::ostringstream c;
+  c << R"(name = "sector"
+[geometry]
+element_order = 1
+mesh_size = 0.03
+[modal]
+modes = 10
+damping_ratio = 0.005
+[contact]
+pairs = 3
+[hbm]
+harmonics = 3
+time_samples = 64
+[continuation]
+initial_step = 0.5
+frequency_start_hz = )"
+    << f0 << "\nfrequency_end_hz = " << f1 << "\n";
+  return c.str();
+}
+
 }  // namespace shroudsim::testing

@@ -73,26 +73,11 @@ TEST(CliContinuation, PeaksLocatedInParallelAreTheSameAtAnyThreadCount) {
   // 10 node pairs, H = 5), with several peaks, 1 and 2 threads write the same curve and the
   // same located peaks, bit for bit.
   const Scratch s("parallel_peaks");
-  s.write("case.toml", R"(name = "peaks"
-[geometry]
-element_order = 1
-mesh_size = 0.03
-[modal]
-modes = 10
-damping_ratio = 0.005
-[contact]
-pairs = "all"
-discretization = "nodes"
-[hbm]
-harmonics = 5
-time_samples = 64
-[continuation]
-initial_step = 0.5
-frequency_start_hz = 80
-frequency_end_hz = 130
-)");
+  s.write("case.toml", coarse_sector_case(80.0, 130.0));
   for (const char* t : {"1", "2"}) {
-    const CliResult r = s.run(std::string("frf case.toml --quiet --no-plots --threads ") + t + " --out out" + t);
+    const CliResult r =
+        s.run(std::string("frf case.toml --quiet --no-plots --set 'contact.pairs=\"all\"' ") +
+              "--set 'contact.discretization=\"nodes\"' --set hbm.harmonics=5 --threads " + t + " --out out" + t);
     ASSERT_EQ(r.status, 0) << r.err;
   }
   const auto frf = frf_of(s, "out1");

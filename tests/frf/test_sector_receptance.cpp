@@ -129,17 +129,34 @@ TEST(SectorReceptance, ModalSumWithResidualFlexibilityMatchesTheDirectSolve) {
   }
 }
 
+/// The shapes tests' forcing: excitation and response at two interior nodes.
+SectorForcing shape_forcing(const Fixture& f, int engine_order) {
+  SectorForcing forcing;
+  forcing.engine_order = engine_order;
+  forcing.excitation_node = f.mesh.n_nodes() / 2;
+  forcing.response_node = f.mesh.n_nodes() / 3;
+  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  return forcing;
+}
+
+/// Seeded random contact-force harmonics F_0..F_H (c each; F_0 real, as the static harmonic is).
+std::vector<Eigen::VectorXcd> random_forces(int n_harmonics, int c, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<Eigen::VectorXcd> forces(static_cast<std::size_t>(n_harmonics) + 1, Eigen::VectorXcd(c));
+  for (auto& fn : forces)
+    for (int i = 0; i < c; ++i) fn[i] = Complex(g(rng), g(rng));
+  forces[0] = forces[0].real().cast<Complex>();
+  return forces;
+}
+
 // The receptance data is linear in the force (its excitation row): a part built for f and
 // scaled by a (scale_force, what a cache entry of another excitation level gets) has the data,
 // receptances and kept static solutions of a part built for a f, to round-off.
 TEST(SectorReceptance, ScalingTheForceIsBuildingWithTheScaledForce) {
   const Fixture f;
   const std::vector<SectorContactPair> pairs = some_pairs(f, 3, 2, 0.3, 0.2, Eigen::Vector3d(1, 2, 3));
-  SectorForcing forcing;
-  forcing.engine_order = 3;
-  forcing.excitation_node = f.mesh.n_nodes() / 2;
-  forcing.response_node = f.mesh.n_nodes() / 3;
-  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
+  SectorForcing forcing = shape_forcing(f, 3);
   forcing.damping_ratio = 0.01;
   modal::ModalOptions mo;
   mo.modes = 10;
@@ -191,27 +208,6 @@ TEST(SectorReceptance, ScalingTheForceIsBuildingWithTheScaledForce) {
     ASSERT_TRUE(y1 && y2) << "the coarse sector keeps its static solutions";
     near(*y1, *y2, "static solution of index " + std::to_string(h));
   }
-}
-
-/// The shapes tests' forcing: excitation and response at two interior nodes.
-SectorForcing shape_forcing(const Fixture& f, int engine_order) {
-  SectorForcing forcing;
-  forcing.engine_order = engine_order;
-  forcing.excitation_node = f.mesh.n_nodes() / 2;
-  forcing.response_node = f.mesh.n_nodes() / 3;
-  forcing.force = Eigen::Vector3d(1.0, -0.5, 0.25);
-  return forcing;
-}
-
-/// Seeded random contact-force harmonics F_0..F_H (c each; F_0 real, as the static harmonic is).
-std::vector<Eigen::VectorXcd> random_forces(int n_harmonics, int c, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g;
-  std::vector<Eigen::VectorXcd> forces(static_cast<std::size_t>(n_harmonics) + 1, Eigen::VectorXcd(c));
-  for (auto& fn : forces)
-    for (int i = 0; i < c; ++i) fn[i] = Complex(g(rng), g(rng));
-  forces[0] = forces[0].real().cast<Complex>();
-  return forces;
 }
 
 // The whole-sector displacement of the shapes (frf.vtu): its contact and response rows are the
