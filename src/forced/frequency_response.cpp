@@ -793,7 +793,7 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
   // workers; then in order, skipping tops located before.
   const auto t0 = std::chrono::steady_clock::now();
   struct Candidate {
-    std::size_t i = 0, m = 0;  // the point, its place in the piece
+    std::size_t i = 0;  // the sampled maximum's point
     int piece = 0;
     bool inner = false;  // with a point on either side in its piece
     std::array<const continuation::BranchPoint*, 3> pts{};
@@ -813,7 +813,6 @@ void analyse_and_locate_peaks(FrequencyResponse& out, const FrequencyResponseSet
     for (std::size_t m : prominent_maxima(amp, kMinProminence)) {
       Candidate cd;
       cd.i = idx[m];
-      cd.m = m;
       cd.piece = pc;
       cd.inner = m > 0 && m + 1 < idx.size();
       if (cd.inner) {
