@@ -32,6 +32,21 @@ PeriodicStatus PeriodicLaw::evaluate(const PairParameters& pair, const Eigen::Ma
   return run<false>(pair, w, f, nullptr, nullptr);
 }
 
+PeriodicStatus PeriodicLaw::sample_steps(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
+                                         std::vector<SampleStep>& steps) {
+  const PeriodicStatus status = evaluate(pair, w, f);
+  // One more period from the converged damper state (the state at the end of the returned
+  // period, which repeats within the period tolerance), each sample's recursion recorded.
+  struct Reset {
+    std::vector<SampleStep>*& p;
+    ~Reset() { p = nullptr; }
+  } reset{steps_};
+  steps.assign(static_cast<std::size_t>(w.rows()), SampleStep{});
+  steps_ = &steps;
+  period<false>(pair, w, f, nullptr, nullptr, false);
+  return status;
+}
+
 namespace {
 // Pseudo-inverse of A = I - Phi_d (2 x 2). Phi_d is a product of per-sample maps: 0 at
 // separation, a contraction at slip, the identity in stick, and exactly neutral directions
@@ -238,6 +253,11 @@ template <bool kD>
   }
   anchor_[0] = {s.l, 1.0, 0.0};
   anchor_[1] = {s.l, 1.0, 0.0};
+  if (steps_ != nullptr) {  // d(l) = w_t(l)
+    SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
+    st.b(0, 0) = 1.0;
+    if (options_.model != Model::one_d) st.b(1, 1) = 1.0;
+  }
   if (track) {
     dd_start_.setZero();
     slipped_ = true;
@@ -256,6 +276,7 @@ template <bool kD>
 template <bool kD>
 [[gnu::always_inline]] inline void PeriodicLaw::record_coupled_stick(int l, PeriodRecorder* rec, bool track) {
   // dT = kt (dw_t - dd), dd unchanged: the runs' damper derivative is the current one.
+  if (steps_ != nullptr) (*steps_)[static_cast<std::size_t>(l)].a.setIdentity();
   if constexpr (kD) {
     if (rec->stick(0, l, xd_) && track) run_d_[0].push_back(dd_start_);
     if (rec->stick(1, l, yd_) && track) run_d_[1].push_back(dd_start_);
@@ -285,6 +306,15 @@ template <bool kD>
     const Eigen::Matrix2d md = r.rho * proj * dd_start_;
     track_coupled_slip<kD>(md, kt);
   }
+  if (steps_ != nullptr) {
+    // dT = mu kn dz(l) e + rho (I - e e^T) kt (dw_t(l) - dd(l-1)), dd(l) = dw_t(l) - dT / kt.
+    SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
+    Eigen::Matrix2d proj;
+    proj << 1.0 - r.ex * r.ex, -r.ex * r.ey, -r.ex * r.ey, 1.0 - r.ey * r.ey;
+    st.a = r.rho * proj;
+    st.b.leftCols<2>() = Eigen::Matrix2d::Identity() - r.rho * proj;
+    st.b.col(2) = -(pair.friction_coefficient * pair.normal_stiffness / kt) * Eigen::Vector2d(r.ex, r.ey);
+  }
   if constexpr (kD)
     rec->radial_return_slip(*basis, s.l, kt, pair.normal_stiffness, pair.friction_coefficient, r.ex, r.ey, r.rho, xd_,
                             yd_);
@@ -310,14 +340,22 @@ template <bool kD>
     // so the sample is an explicit row: de1 = r J_dw (E_t(l) - E_t(lp))
     //   + J_dw dw (dr/dz(l) E_z(l) + dr/dz(lp) E_z(lp)) + J_a1 da1, J_e0 = J_a0 = 0.
     const Eigen::Vector2d dw(s.wx - s.wpx, s.wy - s.wpy);
-    const Eigen::Vector2d e1 =
-        exact_linear_step(Eigen::Vector2d::Zero(), s.r * dw, 0.0, a_end, (kD || track) ? &jl : nullptr, &stuck);
+    const Eigen::Vector2d e1 = exact_linear_step(Eigen::Vector2d::Zero(), s.r * dw, 0.0, a_end,
+                                                 (kD || track || steps_ != nullptr) ? &jl : nullptr, &stuck);
     d_ = {s.wx - e1.x(), s.wy - e1.y()};
-    if (kD || track) {
+    if (kD || track || steps_ != nullptr) {
       const Eigen::Vector2d jdw = jl.middleCols<2>(2) * dw;  // de1/dr
       jl.leftCols<2>().setZero();
       jl.col(4).setZero();
       jl.middleCols<2>(2) *= s.r;
+      if (steps_ != nullptr) {  // dd(l) = dw_t(l) - de1, no dependence on dd(l-1)
+        SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
+        const double ca = mu * pair.normal_stiffness / kt;
+        st.b.leftCols<2>() = Eigen::Matrix2d::Identity() - jl.middleCols<2>(2);
+        st.b.col(2) = -(s.dr_dz * jdw + ca * jl.col(5));
+        st.c.leftCols<2>() = jl.middleCols<2>(2);
+        st.c.col(2) = -s.dr_dz_prev * jdw;
+      }
       if (track) track_coupled_slip<kD>(Eigen::Matrix2d::Zero(), kt);  // e1 does not depend on d_start
       if constexpr (kD)
         rec->exact_linear_slip(*basis, s.l, s.lp, kt, pair.normal_stiffness, mu, false, jl, xd_, yd_,
@@ -331,7 +369,7 @@ template <bool kD>
   const double a = mu * s.nprev / kt;
   Eigen::Vector2d e1 = exact_linear_step(e0, dw, a, a_end, kD ? &jl : nullptr, &stuck);
   // Forces-only tracking: the step's Jacobian only where it does not simply stick.
-  if (!kD && track && !stuck) e1 = exact_linear_step(e0, dw, a, a_end, &jl, &stuck);
+  if (!kD && (track || steps_ != nullptr) && !stuck) e1 = exact_linear_step(e0, dw, a, a_end, &jl, &stuck);
   d_ = {s.wx - e1.x(), s.wy - e1.y()};
   if (stuck) {  // e1 = e0 + dw
     record_coupled_stick<kD>(s.l, rec, track);
@@ -343,6 +381,17 @@ template <bool kD>
     }
     if constexpr (kD)
       rec->exact_linear_slip(*basis, s.l, s.lp, kt, pair.normal_stiffness, mu, s.pressed_prev, jl, xd_, yd_);
+    if (steps_ != nullptr) {
+      // de1 = J_e0 (dw_t(l-1) - dd(l-1)) + J_dw (dw_t(l) - dw_t(l-1)) + J_a0 da0 + J_a1 da1,
+      // dd(l) = dw_t(l) - de1.
+      SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
+      const double ca = mu * pair.normal_stiffness / kt;
+      st.a = jl.leftCols<2>();
+      st.b.leftCols<2>() = Eigen::Matrix2d::Identity() - jl.middleCols<2>(2);
+      st.b.col(2) = -ca * jl.col(5);
+      st.c.leftCols<2>() = jl.middleCols<2>(2) - jl.leftCols<2>();
+      if (s.pressed_prev) st.c.col(2) = -ca * jl.col(4);
+    }
   }
   return {kt * e1.x(), kt * e1.y()};
 }
@@ -407,6 +456,25 @@ template <bool kD>
         else rec->stick_anchored(i, s.l, anchor_[i].s, anchor_[i].alpha, anchor_[i].beta);
       }
     }
+    if (steps_ != nullptr) {
+      // The row of axis i: d(l) = w(l) - e(l) with e clamped (slip), taken from the closing
+      // instant, reset at l-1 (a clamped start), or held (stick).
+      SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
+      if (step.slip != 0.0) {
+        st.b(i, i) = 1.0;
+        st.b(i, 2) = -step.slip * ca;
+      } else if (exact && s.closing) {
+        st.b(i, i) = 1.0 - s.r;
+        st.c(i, i) = s.r;
+        st.b(i, 2) = -(wi - wpi) * s.dr_dz;
+        st.c(i, 2) = -(wi - wpi) * s.dr_dz_prev;
+      } else if (step.start != 0.0) {
+        st.c(i, i) = 1.0;
+        st.c(i, 2) = s.pressed_prev ? -step.start * ca : 0.0;
+      } else {
+        st.a(i, i) = 1.0;
+      }
+    }
     t[static_cast<std::size_t>(i)] = step.t;
   }
   return t;
@@ -462,6 +530,7 @@ void PeriodicLaw::period(const PairParameters& pair, const Eigen::MatrixX3d& w, 
       s.dr_dz_prev = kn * nl_raw / (span * span);
     }
     if constexpr (kD) rec->set_pressed(l, pressed && has_normal);
+    if (steps_ != nullptr) (*steps_)[static_cast<std::size_t>(l)].pressed = pressed && has_normal;
 
     std::array<double, 2> t{0.0, 0.0};
     if (!pressed || !(s.lim > 0.0)) separate<kD>(s, basis, rec, track);

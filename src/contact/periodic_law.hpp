@@ -45,6 +45,21 @@ struct PeriodicStatus {
                           ///< once more, not counted
 };
 
+/// One sample of the steady period as a linear recursion of the damper position d (2, x and
+/// y; the 1d model's y row is zero), for a perturbation u = (x, y, z) of the relative
+/// displacement samples:  d(l) = a d(l-1) + b u(l) + c u(l-1),  and the forces
+/// T(l) = kt (w_t(l) - d(l)) (x only for the 1d model), N(l) = kn z(l) where `pressed`
+/// (3D models). This is the derivative of section 5 unrolled in time: the damper carries the
+/// law's memory from one sample to the next, which a Floquet perturbation e^{lambda t} p(t)
+/// weighs by e^{-lambda dt} per sample (docs/physics.md section 9, "Friction: the slider as a
+/// state").
+struct SampleStep {
+  Eigen::Matrix2d a = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 2, 3> b = Eigen::Matrix<double, 2, 3>::Zero();
+  Eigen::Matrix<double, 2, 3> c = Eigen::Matrix<double, 2, 3>::Zero();
+  bool pressed = false;
+};
+
 /// The discrete periodic law of one pair with reusable scratch. Not thread-safe: use one
 /// instance per thread. Model one_d_exact is not a time recursion and is refused here
 /// (see jenkins.hpp).
@@ -59,6 +74,11 @@ class PeriodicLaw {
   /// LinearizedPeriod), carried exactly through all repeated periods.
   PeriodicStatus evaluate(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
                           const Eigen::MatrixXd* basis = nullptr, LinearizedPeriod* lin = nullptr);
+
+  /// The steady period (as evaluate, forces only) and then its samples' recursion: one more
+  /// period from the converged damper state, each sample linearized (steps: N entries).
+  PeriodicStatus sample_steps(const PairParameters& pair, const Eigen::MatrixX3d& w, Eigen::MatrixX3d& f,
+                              std::vector<SampleStep>& steps);
 
   const LawOptions& options() const { return options_; }
 
@@ -106,6 +126,8 @@ class PeriodicLaw {
   void track_coupled_slip(const Eigen::Matrix2d& md, double kt);
 
   LawOptions options_;
+  // sample_steps(): the linearized recursion of each sample of the replayed period, else null.
+  std::vector<SampleStep>* steps_ = nullptr;
   // Derivative scratch of the coupled model: d(damper position)/dc, one row (P) per
   // tangential direction.
   Eigen::RowVectorXd xd_, yd_;

@@ -147,6 +147,7 @@ class ReducedEquations : public continuation::ParametricResidual {
   std::vector<Eigen::VectorXcd> contact_force_harmonics(const Eigen::VectorXd& w);
 
   const hbm::HarmonicLayout& pair_layout() const { return contacts_.pair_layout(); }
+  hbm::ContactEvaluator& contacts() { return contacts_; }
   int n_pairs() const { return contacts_.n_pairs(); }
   const frf::LinearPart& linear_part() const { return linear_; }
   /// dF_p/dW_p of every pair at w (the contact Jacobian blocks of evaluate(), pair layout);

@@ -18,10 +18,13 @@
 // eigenvalues hold each Floquet exponent 2H + 1 times, shifted by i k w, when D is
 // block-Toeplitz (a memoryless law: the gap, a cubic spring); the truncation spoils the copies
 // whose eigenvectors crowd the outer harmonics. The friction slider's memory makes D depend on
-// more than k - l (its stick runs' anchors), and the copies are no longer exact. Selection:
+// more than k - l (its stick runs' anchors), and the copies are no longer exact; D also takes
+// each step of that memory at the period's rate, which ContactMemory (the slider as a state)
+// corrects. Selection:
 //   symmetry  (default) the exponents whose eigenvector's harmonic centroid
 //             sum_k k q_k^H M_k q_k / sum_k q_k^H M_k q_k (mass-weighted: the same in any
-//             coordinates) lies within half a harmonic of 0;
+//             coordinates) lies within 0.6 harmonics of 0 (a period-doubling exponent's two
+//             copies sit near +-0.5);
 //   imaginary the 2 m exponents nearest the real axis (m = size of the k = 0 block), to compare.
 // FE sector (frf::SectorLinearPart): a perturbation of the travelling-wave solution splits into
 // families p = 0..Nb - 1: block k of family p holds the modes of harmonic index p + k m mod Nb
@@ -40,6 +43,8 @@
 #include <string>
 #include <vector>
 
+#include "contact/contact_law.hpp"
+#include "contact/periodic_law.hpp"
 #include "forced/reduced_equations.hpp"
 
 namespace shroudsim::forced {
@@ -64,6 +69,30 @@ constexpr double kModeCutoff = 2.0;
 /// family and point); larger problems are not analysed.
 constexpr int kMaxCondensedSize = 600;
 
+/// The largest eigenproblem with the slider as a state (companion plus one unknown per
+/// tangential direction and time sample of every pair; dense, O(size^3)); larger problems are
+/// not analysed.
+constexpr int kMaxSliderStateSize = 1200;
+
+/// The friction law's memory at a solution, for Hill's method with the slider as a state
+/// (docs/physics.md section 9, "Friction: the slider as a state"): each pair's samples'
+/// recursion d(l) = a d(l-1) + b u(l) + c u(l-1) (contact::SampleStep). A perturbation
+/// e^{lambda t} p(t) weighs each step by e^{-lambda dt}, dt = T / N, which the harmonic balance's
+/// dF/dW takes as 1; here it is the Cayley form (1 - lambda dt / 2) / (1 + lambda dt / 2)
+/// (error (lambda dt)^3 / 12 per step), so the eigenproblem stays linear in lambda, with the
+/// damper positions of every sample as unknowns. At lambda = 0 it is dF/dW exactly.
+struct ContactMemory {
+  contact::Model model = contact::Model::full3d;
+  std::vector<contact::PairParameters> pairs;
+  std::vector<std::vector<contact::SampleStep>> steps;  ///< per pair, N samples
+  /// A sample whose damper depends on the sample before (a stick run, a coupled slip, the
+  /// motion's previous sample in an exact_linear step): without any, the law is memoryless
+  /// and the harmonic balance's dF/dW is exact.
+  bool carries_memory() const;
+};
+/// The memory of the contacts of `equations` at w.
+ContactMemory contact_memory(ReducedEquations& equations, const Eigen::VectorXd& w);
+
 enum class ExponentSelection { symmetry, imaginary };
 
 struct FloquetResult {
@@ -86,16 +115,18 @@ struct FloquetResult {
 /// The Floquet exponents of the solution w of `equations` at frequency f [Hz], over the
 /// perturbation families the linear part holds (frf::LinearPart::perturbation_families); a
 /// modal form keeps its modes up to mode_cutoff (H + 1) w (0: every mode).
+/// memory: the contact with the slider as a state (ContactMemory), else the harmonic
+/// balance's dF/dW.
 FloquetResult floquet_exponents(ReducedEquations& equations, const Eigen::VectorXd& w, double frequency_hz,
                                 ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize,
-                                double mode_cutoff = kModeCutoff);
+                                double mode_cutoff = kModeCutoff, const ContactMemory* memory = nullptr);
 /// The same from the contact Jacobian's blocks at the solution (ReducedEquations::contact_jacobian,
 /// one dF_p/dW_p per pair in `layout`): it touches no state of the equations, so several points
 /// can be analysed at once.
 FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::HarmonicLayout& layout,
                                 const std::vector<Eigen::MatrixXd>& jacobian, double frequency_hz,
                                 ExponentSelection selection = ExponentSelection::symmetry, int max_size = kMaxHillSize,
-                                double mode_cutoff = kModeCutoff);
+                                double mode_cutoff = kModeCutoff, const ContactMemory* memory = nullptr);
 
 /// Where the stability changes between two neighbouring points of a branch.
 struct StabilityChange {

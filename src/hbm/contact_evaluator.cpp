@@ -312,6 +312,19 @@ EvaluationStatus ContactEvaluator::evaluate(const Eigen::VectorXd& w, Eigen::Vec
   return out;
 }
 
+std::vector<std::vector<contact::SampleStep>> ContactEvaluator::sample_steps(const Eigen::VectorXd& w) {
+  SHROUDSIM_CHECK(options_.law.model != contact::Model::one_d_exact, "sample_steps: 1d_exact is not a recursion");
+  SHROUDSIM_CHECK(w.size() == size(), "sample_steps: w has the wrong size");
+  if (!w.allFinite()) throw std::invalid_argument("ContactEvaluator::sample_steps: non-finite W");
+  Workspace& ws = *workspaces_[0];
+  std::vector<std::vector<contact::SampleStep>> out(pairs_.size());
+  for (int p = 0; p < n_pairs(); ++p) {
+    to_time(w.data() + static_cast<Eigen::Index>(p) * layout_.size(), ws);
+    ws.law.sample_steps(pairs_[static_cast<std::size_t>(p)], ws.w, ws.f, out[static_cast<std::size_t>(p)]);
+  }
+  return out;
+}
+
 void ContactEvaluator::evaluate_pair(int pair, const Eigen::VectorXd& w_pair, PairDetail& d, bool with_jacobian) {
   SHROUDSIM_CHECK(pair >= 0 && pair < n_pairs(), "evaluate_pair: no such pair");
   SHROUDSIM_CHECK(w_pair.size() == layout_.size(), "evaluate_pair: w has the wrong size");

@@ -93,6 +93,11 @@ class ContactEvaluator : public NonlinearForce {
   EvaluationStatus evaluate(const Eigen::VectorXd& w, Eigen::VectorXd& f, std::vector<Eigen::MatrixXd>* jacobian,
                             JacobianMethod method);
 
+  /// Each pair's steady period at W as a recursion of its samples
+  /// (contact::PeriodicLaw::sample_steps): the law's memory, for Hill's method with the slider
+  /// as a state (forced/stability.hpp). Serial. 1d_exact (not a time recursion) refuses
+  /// (std::logic_error).
+  std::vector<std::vector<contact::SampleStep>> sample_steps(const Eigen::VectorXd& w);
   /// One pair (coefficients w_pair of pair_layout().size()) with its time histories.
   void evaluate_pair(int pair, const Eigen::VectorXd& w_pair, PairDetail& detail, bool with_jacobian);
 

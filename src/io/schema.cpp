@@ -566,10 +566,10 @@ Schema declare() {
   d.choice("response.stability_method", at(&Case::response, &ResponseSection::stability_method),
            StabilityMethod::automatic, {StabilityMethod::automatic, StabilityMethod::hill, StabilityMethod::shooting},
            to_string,
-           "frf: how the points are judged (docs/physics.md section 9): hill = Hill's method on the harmonic "
-           "balance's linearization (any model; with friction it drops the slider's memory); shooting = Floquet "
-           "multipliers of the time integration's period map (lumped models); auto = shooting for a lumped model "
-           "with friction, hill otherwise")
+           "frf: how the points are judged (docs/physics.md section 9): hill = Hill's method (any model; with "
+           "friction the slider is a state of the eigenproblem, whose size then grows by N per tangential direction "
+           "and pair); shooting = Floquet multipliers of the time integration's period map (lumped models); auto = "
+           "shooting for a lumped model with friction, hill otherwise")
       .rule("shooting: a lumped structure (the FE sector has no time integration)",
             [](const Case& c, const StabilityMethod& v) { return v != StabilityMethod::shooting || lumped(c); });
   d.integer("response.shooting_steps", at(&Case::response, &ResponseSection::shooting_steps), 4096, "",

@@ -219,11 +219,11 @@ bool judged_by_shooting(const io::Case& c) {
 std::string sector_stability_refusal(const io::Case& c) {
   if (c.structure.type != io::StructureType::sector) return "";
   return "not analysed for an FE sector (docs/physics.md section 9): the analysis judges every harmonic index's "
-         "perturbations (forced::floquet_exponents over the sector's perturbation families), but its verdicts "
-         "are not yet trustworthy there: with friction the contact's linearization (the harmonic balance's) drops "
-         "the slider's memory for a perturbation at its own rate, and on the coarse test sector it calls the "
-         "solution far below resonance unstable in other harmonic indices; with frictionless contacts its "
-         "verdicts change with H (3, 5, 7)";
+         "perturbations (forced::floquet_exponents over the sector's perturbation families, with the slider as a "
+         "state where the contact has friction), but no independent reference confirms its verdicts there: on the "
+         "coarse test sector it calls the solution far below resonance unstable in other harmonic indices "
+         "(combinations of modes at 2 to 4 times the excitation frequency), and its verdicts change with H "
+         "(3, 5, 7), with friction and without";
 }
 
 ForcedModel make_sector_model(Context& ctx) {

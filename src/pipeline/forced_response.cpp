@@ -76,32 +76,44 @@ void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyRes
 /// was not analysed.
 std::vector<forced::FloquetResult> hill_stability(const forced::FrequencyResponse& response,
                                                   forced::ReducedEquations& equations, int threads,
-                                                  std::vector<std::string>& errors) {
+                                                  std::vector<std::string>& errors,
+                                                  const std::vector<forced::FloquetResult>* only = nullptr) {
   const std::size_t n = response.points.size();
   std::vector<forced::FloquetResult> out(n);
   errors.assign(n, std::string());
+  // The points analysed: every one, or those `only` judged (Hill's verdicts are compared there).
+  std::vector<std::size_t> points;
+  for (std::size_t i = 0; i < n; ++i)
+    if (only == nullptr || (*only)[i].available) points.push_back(i);
   // Per batch of points: their contact Jacobians in order (the evaluator is not shared between
   // threads), then their Hill problems in parallel. Each is a pure function of its point, so
   // the result does not depend on the thread count; the batch bounds the Jacobians held.
   constexpr std::size_t kBatch = 64;
   std::vector<std::vector<Eigen::MatrixXd>> jacobians(kBatch);
-  for (std::size_t first = 0; first < n; first += kBatch) {
-    const std::size_t count = std::min(kBatch, n - first);
+  // A friction law's memory (the slider as a state, docs/physics.md section 9); 1d_exact is
+  // time-continuous and has no samples.
+  const bool with_memory = equations.contacts().options().law.model != contact::Model::one_d_exact;
+  std::vector<forced::ContactMemory> memories(kBatch);
+  for (std::size_t first = 0; first < points.size(); first += kBatch) {
+    const std::size_t count = std::min(kBatch, points.size() - first);
     for (std::size_t i = 0; i < count; ++i) {
       jacobians[i].clear();
       try {
-        jacobians[i] = equations.contact_jacobian(response.points[first + i].x);
+        jacobians[i] = equations.contact_jacobian(response.points[points[first + i]].x);
+        if (with_memory) memories[i] = forced::contact_memory(equations, response.points[points[first + i]].x);
       } catch (const NumericalError& e) {
-        errors[first + i] = e.what();
+        errors[points[first + i]] = e.what();
       }
     }
     const int jobs = static_cast<int>(count);
     linalg::parallel_for(jobs, linalg::worker_count(threads, jobs), [&](int i) {
-      const std::size_t k = first + static_cast<std::size_t>(i);
+      const std::size_t k = points[first + static_cast<std::size_t>(i)];
       if (!errors[k].empty()) return;
       try {
-        out[k] = forced::floquet_exponents(equations.linear_part(), equations.pair_layout(),
-                                           jacobians[static_cast<std::size_t>(i)], response.points[k].lambda);
+        out[k] = forced::floquet_exponents(
+            equations.linear_part(), equations.pair_layout(), jacobians[static_cast<std::size_t>(i)],
+            response.points[k].lambda, forced::ExponentSelection::symmetry, forced::kMaxHillSize, forced::kModeCutoff,
+            with_memory ? &memories[static_cast<std::size_t>(i)] : nullptr);
       } catch (const NumericalError& e) {
         errors[k] = e.what();
       }
@@ -111,8 +123,8 @@ std::vector<forced::FloquetResult> hill_stability(const forced::FrequencyRespons
 }
 
 /// The Floquet multipliers of every point by shooting on the time integration
-/// (forced/shooting.hpp): the lumped models with friction, whose slider memory Hill's
-/// linearization drops. `s` gets the shooting's own figures.
+/// (forced/shooting.hpp): the lumped models with friction, the independent reference for Hill's
+/// method with the slider as a state. `s` gets the shooting's own figures.
 std::vector<forced::FloquetResult> shooting_stability(
     const forced::FrequencyResponse& response, forced::ReducedEquations& equations, const frf::LumpedLinearPart& lumped,
     const std::vector<contact::PairParameters>& pairs, contact::Model law, const io::ResponseSection& settings,
@@ -234,9 +246,10 @@ void report_stability(nlohmann::json& s, const std::vector<forced::FloquetResult
 }
 
 /// The stability of every point and run.json's frf.stability, by response.stability_method:
-/// "auto" judges a lumped model with friction by shooting (its slider memory is part of the
-/// time integration's state) and every other model by Hill; with shooting, Hill's verdicts are
-/// counted against it (docs/physics.md section 9).
+/// "auto" judges a lumped model with friction by shooting (the law in continuous time, its
+/// slider part of the integration's state) and every other model by Hill (with friction, the
+/// slider as a state); with shooting, Hill's verdicts are counted against it (docs/physics.md
+/// section 9).
 std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const forced::FrequencyResponse& response,
                                                      forced::ReducedEquations& equations,
                                                      const hbm::ContactEvaluator& evaluator, contact::Model law,
@@ -245,7 +258,6 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   auto& s = j["stability"];
   s = nlohmann::json::object();
   std::vector<std::string> errors;
-  std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, errors);
   const auto* lumped = dynamic_cast<const frf::LumpedLinearPart*>(&equations.linear_part());
   const auto& pairs = evaluator.pairs();
   const bool friction =
@@ -253,12 +265,10 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   const bool shooting = judged_by_shooting(c);
   if (shooting && lumped == nullptr) throw std::logic_error("analyse_stability: shooting needs a lumped model");
   s["requested"] = io::to_string(c.response.stability_method);
+  // With friction Hill's method takes the slider as a state (forced::ContactMemory).
+  s["linearization"] = friction ? "slider_state" : "harmonic_balance";
   if (!shooting) {
-    if (lumped != nullptr && friction)
-      log::warn(
-          "frf: stability by Hill's method as response.stability_method asks: its linearization drops the "
-          "friction slider's memory, and on lumped friction models it calls stable points unstable "
-          "(docs/physics.md section 9)");
+    std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, errors);
     report_stability(s, hill, errors, response, "hill");
     s["seconds"] = clock.seconds();
     return hill;
@@ -267,7 +277,9 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   std::vector<forced::FloquetResult> out =
       shooting_stability(response, equations, *lumped, pairs, law, c.response, threads, shooting_errors, s);
   report_stability(s, out, shooting_errors, response, "shooting");
-  // Hill's verdicts against the shooting's, where both judged.
+  // Hill's verdicts against the shooting's, where both judged (Hill only at the points the
+  // shooting judged: with the slider as a state it can cost more than the shooting).
+  const std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, errors, &out);
   int hill_unstable = 0, disagree = 0, judged = 0;
   for (std::size_t i = 0; i < out.size(); ++i) {
     if (!hill[i].available || !out[i].available) continue;
@@ -276,8 +288,8 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
     disagree += hill[i].stable != out[i].stable ? 1 : 0;
   }
   s["hill"] = {{"judged_points", judged}, {"unstable_points", hill_unstable}, {"disagreements", disagree}};
-  log::info("frf: Hill's linearization (without the slider memory) disagrees with the shooting at " +
-            std::to_string(disagree) + " of " + std::to_string(judged) + " points");
+  log::info("frf: Hill's method (the slider as a state) disagrees with the shooting at " + std::to_string(disagree) +
+            " of " + std::to_string(judged) + " points");
   s["seconds"] = clock.seconds();
   return out;
 }

@@ -798,9 +798,9 @@ std::string model_8(double s) {
 }
 
 TEST(CliContinuation, ALumpedFrictionModelIsJudgedByShootingTheSameAtAnyTimeScaleAndThreadCount) {
-  // Hill's linearization drops the friction slider's memory and calls stretches of this curve
-  // unstable where the time integration from rest settles on it (forced.Shooting tests); the
-  // shooting on the time integration calls every point stable. The verdicts are a property of
+  // The harmonic balance's linearization (without the slider as a state) calls stretches of this
+  // curve unstable where the time integration from rest settles on it (forced.Shooting tests);
+  // the shooting on the time integration calls every point stable. The verdicts are a property of
   // the motion: the same with time rescaled by 1e-3, and with 1 or 2 threads.
   const Scratch s("shooting");
   std::vector<std::vector<std::vector<std::string>>> tables;
@@ -831,24 +831,34 @@ TEST(CliContinuation, ALumpedFrictionModelIsJudgedByShootingTheSameAtAnyTimeScal
   EXPECT_EQ(tables[0].size(), tables[1].size());
 }
 
-TEST(CliContinuation, HillsMethodIsUsedOnAFrictionModelWhenTheCaseAsksAndWarned) {
-  // response.stability_method = "hill" on a lumped friction model: Hill's verdicts (which drop
-  // the slider's memory) in the `stable` column, with a warning; "auto" judges it by shooting.
+TEST(CliContinuation, HillsMethodTakesTheSliderAsAStateAndAgreesWithTheShootingOnAFrictionModel) {
+  // response.stability_method = "hill" on a lumped friction model (stress model 8): Hill's method
+  // with the slider as a state (docs/physics.md section 9). The harmonic balance's dF/dW called
+  // 8 of every 5th point unstable here where the integration from rest settles on the solution;
+  // with the slider as a state no point is unstable, as the shooting ("auto") finds, and the
+  // shooting run counts no disagreement with it.
   const Scratch s("stability_hill");
   s.write("case.toml", model_8(1.0));
   const CliResult r = s.run("frf case.toml --threads 2 --out hill --set response.stability_method=\"hill\"");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("drops the friction slider's memory"), std::string::npos) << r.err;
   const auto frf = frf_of(s, "hill");
   const auto& st = frf["stability"];
   EXPECT_EQ(st["requested"].get<std::string>(), "hill");
   EXPECT_EQ(st["method"].get<std::string>(), "hill");
+  EXPECT_EQ(st["linearization"].get<std::string>(), "slider_state");
   EXPECT_FALSE(st.contains("hill"));
-  EXPECT_GT(st["unstable_points"].get<int>(), 0);  // the points the shooting calls stable
+  EXPECT_EQ(st["unstable_points"].get<int>(), 0);
   const auto rows = csv_rows(slurp(s.dir() / "hill" / "frf.csv"));
-  int zeros = 0;
-  for (std::size_t i = 1; i < rows.size(); ++i) zeros += rows[i].back() == "0" ? 1 : 0;
-  EXPECT_EQ(zeros, st["unstable_points"].get<int>());
+  int ones = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) ones += rows[i].back() == "1" ? 1 : 0;
+  EXPECT_EQ(ones, static_cast<int>(rows.size()) - 1);
+
+  const CliResult a = s.run("frf case.toml --threads 2 --out auto");
+  ASSERT_EQ(a.status, 0) << a.err;
+  const auto& sa = frf_of(s, "auto")["stability"];
+  EXPECT_EQ(sa["method"].get<std::string>(), "shooting");
+  EXPECT_GT(sa["hill"]["judged_points"].get<int>(), 100);
+  EXPECT_EQ(sa["hill"]["disagreements"].get<int>(), 0);
 }
 
 }  // namespace

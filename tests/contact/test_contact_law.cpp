@@ -9,6 +9,8 @@
 #include <random>
 #include <vector>
 
+#include <Eigen/LU>
+
 #include "contact/friction_step.hpp"
 #include "contact/periodic_law.hpp"
 #include "separation_reference.hpp"
@@ -303,6 +305,70 @@ TEST(PeriodicLaw, DerivativeThroughClosingMatchesCentralDifferences) {
       }
     }
   }
+}
+
+// The samples' recursion (PeriodicLaw::sample_steps), solved around the period, is the
+// analytical derivative of the steady period: the recursion is that derivative unrolled in
+// time, so the two must agree to round-off for every model and update, with slip and with
+// separation (states where every direction slips or separates somewhere in the period, so
+// the periodic damper state is unique).
+Eigen::MatrixXd unrolled_derivative(const std::vector<shroudsim::contact::SampleStep>& steps, const PairParameters& p,
+                                    Model model, const Eigen::MatrixXd& basis) {
+  const int n = static_cast<int>(steps.size()), m = static_cast<int>(basis.cols());
+  const int nd = shroudsim::contact::n_directions(model), nt = model == Model::one_d ? 1 : 2;
+  Eigen::MatrixXd cyclic = Eigen::MatrixXd::Identity(2 * n, 2 * n);
+  for (int l = 0; l < n; ++l) cyclic.block(2 * l, 2 * ((l + n - 1) % n), 2, 2) -= steps[l].a;
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(cyclic);
+  Eigen::MatrixXd df = Eigen::MatrixXd::Zero(nd * n, nd * m);  // rows: direction i, sample l
+  for (int j = 0; j < nd; ++j)
+    for (int k = 0; k < m; ++k) {
+      Eigen::MatrixX3d u = Eigen::MatrixX3d::Zero(n, 3);
+      u.col(model == Model::one_d ? 0 : j) = basis.col(k);
+      Eigen::VectorXd rhs(2 * n);
+      for (int l = 0; l < n; ++l)
+        rhs.segment<2>(2 * l) = steps[l].b * u.row(l).transpose() + steps[l].c * u.row((l + n - 1) % n).transpose();
+      const Eigen::VectorXd d = lu.solve(rhs);
+      for (int l = 0; l < n; ++l) {
+        for (int i = 0; i < nt; ++i) df(i * n + l, j * m + k) = p.tangential_stiffness * (u(l, i) - d(2 * l + i));
+        if (nd == 3) df(2 * n + l, j * m + k) = steps[l].pressed ? p.normal_stiffness * u(l, 2) : 0.0;
+      }
+    }
+  return df;
+}
+
+TEST(PeriodicLaw, TheSamplesRecursionAroundThePeriodIsTheAnalyticalDerivative) {
+  constexpr int kN = 64, kM = 5;
+  const PairParameters p{
+      .tangential_stiffness = 2.0e5, .normal_stiffness = 5.0e5, .friction_coefficient = 0.4, .normal_preload = 3.0};
+  const Eigen::MatrixXd basis = random_basis(kN, kM, 31);
+  // Two motions: a slipping elliptical orbit with a varying load, and one that separates
+  // over about a third of the period (tests/contact/separation_reference.hpp).
+  const std::vector<Eigen::MatrixX3d> motions{orbit(kN, 4.3e-5, 3.1e-5, 0.8, 1e-6, 8e-6),
+                                              shroudsim::testing::separating_motion(p, 0.5).sample(kN, 0.37)};
+  // Both sides are the same products and sums in another order: round-off of a 2N-wide
+  // dense solve on O(1) entries.
+  constexpr double kTol = 1e-9;
+  for (std::size_t motion = 0; motion < motions.size(); ++motion)
+    for (Model model : {Model::full3d, Model::quasi3d, Model::one_d})
+      for (auto update : {TangentialUpdate::radial_return, TangentialUpdate::exact_linear}) {
+        PeriodicLaw law({.model = model, .update = update});
+        Eigen::MatrixX3d f, f_steps;
+        shroudsim::contact::LinearizedPeriod lin;
+        law.evaluate(p, motions[motion], f, &basis, &lin);
+        std::array<shroudsim::contact::RowMatrix, 3> expanded;
+        lin.expand(basis, expanded);
+        std::vector<shroudsim::contact::SampleStep> steps;
+        law.sample_steps(p, motions[motion], f_steps, steps);
+        ASSERT_EQ(steps.size(), static_cast<std::size_t>(kN));
+        EXPECT_LT((f_steps - f).cwiseAbs().maxCoeff(), 1e-9 * f.cwiseAbs().maxCoeff());
+        const int nd = shroudsim::contact::n_directions(model);
+        Eigen::MatrixXd reference(nd * kN, nd * kM);
+        for (int i = 0; i < nd; ++i) reference.middleRows(i * kN, kN) = expanded[static_cast<std::size_t>(i)];
+        const Eigen::MatrixXd unrolled = unrolled_derivative(steps, p, model, basis);
+        EXPECT_LT((unrolled - reference).cwiseAbs().maxCoeff(), kTol * reference.cwiseAbs().maxCoeff())
+            << "motion " << motion << " " << shroudsim::contact::to_string(model) << " "
+            << shroudsim::contact::to_string(update);
+      }
 }
 
 TEST(PairParameters, RefusesBadValuesNamingTheKey) {

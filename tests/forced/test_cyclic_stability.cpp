@@ -38,7 +38,9 @@
 #include <vector>
 
 #include "forced/frequency_response.hpp"
+#include "forced/shooting.hpp"
 #include "forced/stability.hpp"
+#include "forced/time_march.hpp"
 #include "frf/lumped.hpp"
 
 namespace shroudsim::forced {
@@ -76,6 +78,9 @@ constexpr double kMappingTol = 1e-12;
 // change of coordinates: the eigenvalues of 100- to 260-wide companion matrices whose entries
 // reach (w_max / w)^2 ~ 30: round-off, measured <= 1.0e-13 over the 14 points.
 constexpr double kSameSpectrumTol = 1e-11;
+// |lambda| / w below this is the neutral exponent of a stuck damper (0 up to the round-off of
+// the companion's eigenvalues, 1e-15 measured).
+constexpr double kNeutral = 1e-9;
 // Stick-slip: the contact force reaches the friction limit (to the law's round-off) at some
 // samples and stays clearly below it at others.
 constexpr double kAtLimit = 1e-9, kBelowLimit = 1e-3;
@@ -641,6 +646,66 @@ TEST_P(CyclicStability, InModalCoordinatesTheFamiliesGiveTheWheelsHillExponents)
     ASSERT_TRUE(a.available && b.available) << a.reason << b.reason;
     compare(p, a, b, kSameSpectrumTol, "dF/dW, modal coordinates");
   }
+  RecordProperty("largest_multiplier_difference", sci(worst_));
+}
+
+// With the slider as a state (ContactMemory: the damper position of every sample an unknown,
+// each step weighed by the Floquet factor), the families still give the wheel's exponents: the
+// samples of pair j are those of pair 0 shifted by j m N / Nb samples (an integer at N = 120), so
+// the wheel's pencil is again the direct sum of the families'. Where the contacts stick
+// throughout, every pair's damper position is a neutral direction (exponent 0, the wheel's Nb
+// of them an eigenspace whose basis, and so whose centroids, LAPACK picks): those are compared
+// by their presence, the rest as a multiset. And the verdict is checked against an independent
+// reference, the shooting on the wheel's own time integration (the law in continuous time, a
+// slider per pair): the same at every point it judges.
+FloquetResult without_neutral(FloquetResult r, double f, bool* had_neutral) {
+  *had_neutral = false;
+  FloquetResult out = r;
+  out.exponents.clear();
+  out.exponent_family.clear();
+  for (std::size_t i = 0; i < r.exponents.size(); ++i) {
+    if (std::abs(r.exponents[i]) < kNeutral * 2 * kPi * f) {
+      *had_neutral = true;
+      continue;
+    }
+    out.exponents.push_back(r.exponents[i]);
+    out.exponent_family.push_back(r.exponent_family[i]);
+  }
+  out.max_real = out.exponents.front().real();
+  return out;
+}
+
+TEST_P(CyclicStability, WithTheSliderAsAStateTheFamiliesGiveTheWheelsExponentsAndTheShootingsVerdict) {
+  const std::vector<contact::PairParameters> pairs(static_cast<std::size_t>(GetParam().sectors), s_->pair);
+  const LumpedSystem system = lumped_system(*s_->full);
+  int judged = 0;
+  for (const Point& p : s_->points) {
+    const double f = p.frequency_hz;
+    const Eigen::VectorXd xw = s_->wheel_state(p.x);
+    const ContactMemory sector_memory = contact_memory(*s_->equations, p.x);
+    const ContactMemory wheel_memory = contact_memory(*s_->full_equations, xw);
+    const FloquetResult b = floquet_exponents(*s_->equations, p.x, f, ExponentSelection::symmetry, kMaxHillSize,
+                                              kModeCutoff, &sector_memory);
+    const FloquetResult a = floquet_exponents(*s_->full_equations, xw, f, ExponentSelection::symmetry, kMaxHillSize,
+                                              kModeCutoff, &wheel_memory);
+    ASSERT_TRUE(a.available && b.available) << a.reason << b.reason;
+    // The companion plus one damper position per pair and sample.
+    EXPECT_EQ(b.hill_size, 2 * 2 * (2 * kHarmonics + 1) + kTimeSamples) << p.name();
+    EXPECT_EQ(a.hill_size, 2 * 2 * GetParam().sectors * (2 * kHarmonics + 1) + GetParam().sectors * kTimeSamples);
+    bool neutral_a = false, neutral_b = false;
+    const FloquetResult an = without_neutral(a, f, &neutral_a), bn = without_neutral(b, f, &neutral_b);
+    EXPECT_EQ(neutral_a, !p.stick_slip) << p.name();
+    EXPECT_EQ(neutral_b, !p.stick_slip) << p.name();
+    compare(p, an, bn, kSameSpectrumTol, "slider state");
+    Eigen::VectorXd u0, v0, d0;
+    harmonic_balance_state(*s_->full_equations, *s_->full, pairs, contact::Model::one_d, xw, f, u0, v0, d0);
+    const ShootingResult sh = shooting_floquet(system, pairs, contact::Model::one_d, f, u0, v0, d0);
+    if (!sh.available) continue;
+    ++judged;
+    EXPECT_EQ(sh.stable, b.stable) << p.name() << ": shooting spectral radius " << sh.spectral_radius
+                                   << ", Hill's exp(max_real T) " << std::exp(b.max_real / f);
+  }
+  EXPECT_GE(judged, 5);
   RecordProperty("largest_multiplier_difference", sci(worst_));
 }
 
