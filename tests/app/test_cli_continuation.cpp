@@ -818,9 +818,12 @@ TEST(CliContinuation, ALumpedFrictionModelIsJudgedByShootingTheSameAtAnyTimeScal
     ASSERT_GT(rows.size(), 100u);
     ASSERT_EQ(rows[0].back(), "stable");
     for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_EQ(rows[i].back(), "1") << "row " << i;
-    // Hill's verdicts on the same points are counted against the shooting's.
-    EXPECT_EQ(st["hill"]["judged_points"].get<std::size_t>(), rows.size() - 1);
-    EXPECT_EQ(st["hill"]["disagreements"].get<int>(), st["hill"]["unstable_points"].get<int>());
+    // Hill's verdicts (the slider as a state) are counted against the shooting's at up to 64 of
+    // its points, every ceil(n / 64)-th (202 points: every 4th, 51): none differs.
+    const std::size_t n = rows.size() - 1, stride = (n + 63) / 64;
+    EXPECT_EQ(st["hill"]["judged_points"].get<std::size_t>(), (n + stride - 1) / stride);
+    EXPECT_EQ(st["hill"]["disagreements"].get<int>(), 0);
+    EXPECT_EQ(st["hill"]["unstable_points"].get<int>(), 0);
     tables.push_back(rows);
     if (scale == 1.0) {
       const CliResult r1 = s.run("frf " + name + ".toml --quiet --threads 1 --out " + name + "_t1");
@@ -855,9 +858,10 @@ TEST(CliContinuation, HillsMethodTakesTheSliderAsAStateAndAgreesWithTheShootingO
 
   const CliResult a = s.run("frf case.toml --threads 2 --out auto");
   ASSERT_EQ(a.status, 0) << a.err;
-  const auto& sa = frf_of(s, "auto")["stability"];
+  const auto frf_auto = frf_of(s, "auto");
+  const auto& sa = frf_auto["stability"];
   EXPECT_EQ(sa["method"].get<std::string>(), "shooting");
-  EXPECT_GT(sa["hill"]["judged_points"].get<int>(), 100);
+  EXPECT_GE(sa["hill"]["judged_points"].get<int>(), 50);  // up to 64 of the shooting's points
   EXPECT_EQ(sa["hill"]["disagreements"].get<int>(), 0);
 }
 
