@@ -299,12 +299,12 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   s["hill"] = {{"judged_points", judged}, {"unstable_points", hill_unstable}, {"disagreements", disagree}};
   // Why Hill did not judge a point the shooting judged (the first such reason), if any did not.
   for (std::size_t i = 0; i < out.size(); ++i)
-    if (out[i].available && !hill[i].available) {
+    if (compared[i] != 0 && !hill[i].available) {
       s["hill"]["reason"] = errors[i].empty() ? hill[i].reason : errors[i];
       break;
     }
-  log::info("frf: Hill's method (the slider as a state) disagrees with the shooting at " + std::to_string(disagree) +
-            " of " + std::to_string(judged) + " points");
+  log::info("frf: Hill's method disagrees with the shooting at " + std::to_string(disagree) + " of " +
+            std::to_string(judged) + " points compared");
   s["seconds"] = clock.seconds();
   return out;
 }

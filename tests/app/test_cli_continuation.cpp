@@ -863,6 +863,16 @@ TEST(CliContinuation, HillsMethodTakesTheSliderAsAStateAndAgreesWithTheShootingO
   EXPECT_EQ(sa["method"].get<std::string>(), "shooting");
   EXPECT_GE(sa["hill"]["judged_points"].get<int>(), 50);  // up to 64 of the shooting's points
   EXPECT_EQ(sa["hill"]["disagreements"].get<int>(), 0);
+  EXPECT_FALSE(sa["hill"].contains("reason"));
+
+  // At N = 1024 the pencil (186 + 2 x 1024 wide) is above the size limit: Hill judges none of the
+  // shooting's points, and run.json says why.
+  const CliResult big = s.run("frf case.toml --threads 2 --out big --set hbm.time_samples=1024");
+  ASSERT_EQ(big.status, 0) << big.err;
+  const auto frf_big = frf_of(s, "big");
+  const auto& sb = frf_big["stability"];
+  EXPECT_EQ(sb["hill"]["judged_points"].get<int>(), 0);
+  EXPECT_NE(sb["hill"]["reason"].get<std::string>().find("kMaxSliderStateSize"), std::string::npos) << sb["hill"];
 }
 
 }  // namespace
