@@ -299,18 +299,16 @@ template <bool kD>
     record_coupled_stick<kD>(s.l, rec, track);
     return {r.tx, r.ty};
   }
+  Eigen::Matrix2d proj;  // I - e e^T
+  proj << 1.0 - r.ex * r.ex, -r.ex * r.ey, -r.ex * r.ey, 1.0 - r.ey * r.ey;
   if (track) {
     // d(d_start) only: dT* = -kt D, dT = rho (I - e e^T) dT*, D <- -dT/kt.
-    Eigen::Matrix2d proj;
-    proj << 1.0 - r.ex * r.ex, -r.ex * r.ey, -r.ex * r.ey, 1.0 - r.ey * r.ey;
     const Eigen::Matrix2d md = r.rho * proj * dd_start_;
     track_coupled_slip<kD>(md, kt);
   }
   if (steps_ != nullptr) {
     // dT = mu kn dz(l) e + rho (I - e e^T) kt (dw_t(l) - dd(l-1)), dd(l) = dw_t(l) - dT / kt.
     SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
-    Eigen::Matrix2d proj;
-    proj << 1.0 - r.ex * r.ex, -r.ex * r.ey, -r.ex * r.ey, 1.0 - r.ey * r.ey;
     st.a = r.rho * proj;
     st.b.leftCols<2>() = Eigen::Matrix2d::Identity() - r.rho * proj;
     st.b.col(2) = -(pair.friction_coefficient * pair.normal_stiffness / kt) * Eigen::Vector2d(r.ex, r.ey);
@@ -331,6 +329,7 @@ template <bool kD>
   const double kt = pair.tangential_stiffness;
   const double mu = pair.friction_coefficient;
   const double a_end = s.lim / kt;
+  const double ca = mu * pair.normal_stiffness / kt;  // d(slip radius)/dz
   Eigen::Matrix<double, 2, 6> jl;
   bool stuck = false;
   if (s.closing) {
@@ -350,7 +349,6 @@ template <bool kD>
       jl.middleCols<2>(2) *= s.r;
       if (steps_ != nullptr) {  // dd(l) = dw_t(l) - de1, no dependence on dd(l-1)
         SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
-        const double ca = mu * pair.normal_stiffness / kt;
         st.b.leftCols<2>() = Eigen::Matrix2d::Identity() - jl.middleCols<2>(2);
         st.b.col(2) = -(s.dr_dz * jdw + ca * jl.col(5));
         st.c.leftCols<2>() = jl.middleCols<2>(2);
@@ -385,7 +383,6 @@ template <bool kD>
       // de1 = J_e0 (dw_t(l-1) - dd(l-1)) + J_dw (dw_t(l) - dw_t(l-1)) + J_a0 da0 + J_a1 da1,
       // dd(l) = dw_t(l) - de1.
       SampleStep& st = (*steps_)[static_cast<std::size_t>(s.l)];
-      const double ca = mu * pair.normal_stiffness / kt;
       st.a = jl.leftCols<2>();
       st.b.leftCols<2>() = Eigen::Matrix2d::Identity() - jl.middleCols<2>(2);
       st.b.col(2) = -ca * jl.col(5);

@@ -396,8 +396,9 @@ FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::Harmon
       t_inv(is, row(n)) = i1, t_inv(is, row(-n)) = -i1;
     }
   }
+  // (Not needed with the slider as a state, which takes the law's steps instead.)
   Eigen::MatrixXcd dx = Eigen::MatrixXcd::Zero(ne, ne);
-  for (int p = 0; p < pairs; ++p) {
+  for (int p = 0; memory == nullptr && p < pairs; ++p) {
     const Eigen::MatrixXcd local = t * blocks[static_cast<std::size_t>(p)].cast<Complex>() * t_inv;
     for (int d1 = 0; d1 < nd; ++d1)
       for (int k1 = -h; k1 <= h; ++k1)
