@@ -380,21 +380,6 @@ bool ReducedEquations::evaluate_impl(const Eigen::VectorXd& w, double frequency_
   return ok;
 }
 
-void ReducedEquations::add_statistics(const SolverStatistics& s) {
-  stats_.evaluations += s.evaluations;
-  stats_.jacobian_evaluations += s.jacobian_evaluations;
-  stats_.repeated_evaluations += s.repeated_evaluations;
-  stats_.dense_factorizations += s.dense_factorizations;
-  stats_.krylov_solves += s.krylov_solves;
-  stats_.krylov_iterations += s.krylov_iterations;
-  stats_.krylov_failures += s.krylov_failures;
-  stats_.double_solves += s.double_solves;
-  stats_.contact_seconds += s.contact_seconds;
-  stats_.receptance_seconds += s.receptance_seconds;
-  stats_.jacobian_seconds += s.jacobian_seconds;
-  stats_.solve_seconds += s.solve_seconds;
-}
-
 void ReducedEquations::apply_jacobian(const Eigen::VectorXd& z, Eigen::VectorXd& y) const {
   const int block = contacts_.pair_layout().size();
   Eigen::VectorXd dz(size());

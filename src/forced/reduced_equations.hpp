@@ -87,6 +87,23 @@ struct SolverStatistics {
   double receptance_seconds = 0.0;  ///< G_n, W_lin,n and their frequency derivatives
   double jacobian_seconds = 0.0;    ///< forming I + G D
   double solve_seconds = 0.0;       ///< solve_augmented and solve_bordered
+
+  /// Adds another's counts and times (work split between equations, e.g. a peak's location).
+  SolverStatistics& operator+=(const SolverStatistics& o) {
+    evaluations += o.evaluations;
+    jacobian_evaluations += o.jacobian_evaluations;
+    repeated_evaluations += o.repeated_evaluations;
+    dense_factorizations += o.dense_factorizations;
+    krylov_solves += o.krylov_solves;
+    krylov_iterations += o.krylov_iterations;
+    krylov_failures += o.krylov_failures;
+    double_solves += o.double_solves;
+    contact_seconds += o.contact_seconds;
+    receptance_seconds += o.receptance_seconds;
+    jacobian_seconds += o.jacobian_seconds;
+    solve_seconds += o.solve_seconds;
+    return *this;
+  }
 };
 
 class ReducedEquations : public continuation::ParametricResidual {
@@ -119,7 +136,7 @@ class ReducedEquations : public continuation::ParametricResidual {
   const SolverStatistics& statistics() const { return stats_; }
   /// Adds another object's statistics (equations of the same model that solved part of the
   /// work, e.g. a peak's location) to these.
-  void add_statistics(const SolverStatistics& s);
+  void add_statistics(const SolverStatistics& s) { stats_ += s; }
   /// The Jacobian I + G(f) D formed densely the plain way (G as a dense n x n real matrix times
   /// the block-diagonal D): the reference the structured product is tested against.
   Eigen::MatrixXd dense_jacobian(double frequency_hz, const std::vector<Eigen::MatrixXd>& blocks) const;
