@@ -33,13 +33,18 @@ class PeriodMap {
     dt_ = (1.0 / frequency_hz) / static_cast<double>(steps);
     const Eigen::PartialPivLU<Eigen::MatrixXd> lhs(s.mass + 0.5 * dt_ * s.damping);
     a_force_ = lhs.solve(s.force);
+    a_force_sin_ = lhs.solve(s.sine_force());
     a_stiffness_ = lhs.solve(s.stiffness);
     a_damping_ = lhs.solve(s.damping);
     a_contact_ = lhs.solve(s.contact_operator.transpose());
     mass_llt_.compute(s.mass);
     f_static_ = detail::static_load(pairs, one_d_);
     excitation_.resize(steps);
-    for (long long k = 0; k < steps; ++k) excitation_[k] = std::cos(w_ * static_cast<double>(k + 1) * dt_);
+    excitation_sin_.resize(steps);
+    for (long long k = 0; k < steps; ++k) {
+      excitation_[k] = std::cos(w_ * static_cast<double>(k + 1) * dt_);
+      excitation_sin_[k] = std::sin(w_ * static_cast<double>(k + 1) * dt_);
+    }
   }
   Eigen::Index size() const { return 2 * n_ + dirs_ * static_cast<Eigen::Index>(laws_.size()); }
 
@@ -65,7 +70,7 @@ class PeriodMap {
       v_half = v + (0.5 * dt_) * a;
       contact_force();
       // Products of a few DOFs by a few states: lazy (no blocking, no packing).
-      a1 = (excitation_[k] * a_force_).replicate(1, m);
+      a1 = (excitation_[k] * a_force_ + excitation_sin_[k] * a_force_sin_).replicate(1, m);
       a1.noalias() -= a_stiffness_.lazyProduct(u);
       a1.noalias() -= a_contact_.lazyProduct(fc);
       a1.noalias() -= a_damping_.lazyProduct(v_half);
@@ -88,7 +93,8 @@ class PeriodMap {
   Eigen::Index n_ = 0, dirs_ = 2;
   double dt_ = 0.0;
   std::vector<detail::ElementLaw> laws_;
-  Eigen::VectorXd a_force_, f_static_, excitation_;  // excitation_[k] = cos(w t_{k+1})
+  Eigen::VectorXd a_force_, a_force_sin_, f_static_;
+  Eigen::VectorXd excitation_, excitation_sin_;  // cos(w t_{k+1}), sin(w t_{k+1})
   Eigen::MatrixXd a_stiffness_, a_damping_, a_contact_;
   Eigen::LLT<Eigen::MatrixXd> mass_llt_;
 };
@@ -150,11 +156,8 @@ ShootingResult shooting_floquet(const LumpedSystem& s, const std::vector<contact
   std::vector<std::string> errors;
   if (!o.validate(&errors)) throw std::invalid_argument("shooting options: " + errors.front());
   const Eigen::Index n = s.mass.rows();
-  const Eigen::Index c = 3 * static_cast<Eigen::Index>(pairs.size());
   const Eigen::Index dirs = contact::n_directions(model) == 1 ? 1 : 2;
-  if (n == 0 || s.mass.cols() != n || s.stiffness.rows() != n || s.stiffness.cols() != n || s.damping.rows() != n ||
-      s.damping.cols() != n || s.force.size() != n || s.contact_operator.rows() != c ||
-      s.contact_operator.cols() != n || u0.size() != n || v0.size() != n ||
+  if (!s.consistent(static_cast<Eigen::Index>(pairs.size())) || u0.size() != n || v0.size() != n ||
       sliders0.size() != dirs * static_cast<Eigen::Index>(pairs.size()))
     throw std::invalid_argument("shooting: inconsistent sizes of M, C, K, B, f and the state");
   if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz)) throw std::invalid_argument("shooting: frequency > 0");

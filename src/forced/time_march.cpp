@@ -65,7 +65,14 @@ std::string TimeMarchResult::describe() const {
 }
 
 LumpedSystem lumped_system(const frf::LumpedLinearPart& lumped) {
-  return {lumped.mass(), lumped.damping(), lumped.stiffness(), lumped.contact_operator(), lumped.force_vector()};
+  return {lumped.mass(), lumped.damping(), lumped.stiffness(), lumped.contact_operator(), lumped.force_vector(), {}};
+}
+
+bool LumpedSystem::consistent(Eigen::Index elements) const {
+  const Eigen::Index n = mass.rows();
+  return n > 0 && mass.cols() == n && stiffness.rows() == n && stiffness.cols() == n && damping.rows() == n &&
+         damping.cols() == n && force.size() == n && (force_sin.size() == 0 || force_sin.size() == n) &&
+         contact_operator.rows() == 3 * elements && contact_operator.cols() == n;
 }
 
 double stuck_highest_circular_frequency(const LumpedSystem& s, const std::vector<contact::PairParameters>& pairs,
@@ -89,8 +96,7 @@ TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<c
   if (!o.validate(&errors)) throw std::invalid_argument("time integration options: " + errors.front());
   const Eigen::Index n = s.mass.rows();
   const Eigen::Index c = 3 * static_cast<Eigen::Index>(pairs.size());
-  if (n == 0 || s.mass.cols() != n || s.stiffness.rows() != n || s.stiffness.cols() != n || s.damping.rows() != n ||
-      s.damping.cols() != n || s.force.size() != n || s.contact_operator.rows() != c || s.contact_operator.cols() != n)
+  if (!s.consistent(static_cast<Eigen::Index>(pairs.size())))
     throw std::invalid_argument("time integration: inconsistent sizes of M, C, K, B, f");
   if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz))
     throw std::invalid_argument("time integration: frequency > 0");
@@ -137,7 +143,7 @@ TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<c
   a = mass_llt.solve(s.force - s.stiffness * u - s.contact_operator.transpose() * fc - s.damping * v);
   // (M + dt/2 C) a1 = f cos(w t1) - K u1 - B^T fc - C (v + dt/2 a), with the operator's
   // inverse applied once to each matrix.
-  const Eigen::VectorXd a_force = lhs.solve(s.force);
+  const Eigen::VectorXd a_force = lhs.solve(s.force), a_force_sin = lhs.solve(s.sine_force());
   const Eigen::MatrixXd a_stiffness = lhs.solve(s.stiffness), a_damping = lhs.solve(s.damping),
                         a_contact = lhs.solve(s.contact_operator.transpose());
 
@@ -156,7 +162,7 @@ TimeMarchResult march_to_steady_state(const LumpedSystem& s, const std::vector<c
       u += dt * v + (0.5 * dt * dt) * a;
       v_half = v + (0.5 * dt) * a;
       contact_force();
-      a1 = std::cos(w * t1) * a_force;
+      a1 = std::cos(w * t1) * a_force + std::sin(w * t1) * a_force_sin;
       a1.noalias() -= a_stiffness * u;
       a1.noalias() -= a_contact * fc;
       a1.noalias() -= a_damping * v_half;
@@ -237,6 +243,7 @@ TimeMarchResult march_to_steady_state_cached(const LumpedSystem& system,
   put_matrix(system.stiffness);
   put_matrix(system.contact_operator);
   put_matrix(system.force);
+  put_matrix(system.force_sin);
   for (const contact::PairParameters& p : pairs) {
     for (double v : {p.tangential_stiffness, p.normal_stiffness, p.friction_coefficient, p.normal_preload})
       put(&v, sizeof v);

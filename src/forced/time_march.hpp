@@ -26,11 +26,17 @@ class LumpedLinearPart;
 
 namespace shroudsim::forced {
 
-/// The lumped equations of motion: f(t) = force cos(w t); contact_operator B (3 rows per
+/// The lumped equations of motion: f(t) = force cos(w t) + force_sin sin(w t) (force_sin
+/// empty: none; a travelling wave on a whole wheel needs both); contact_operator B (3 rows per
 /// contact element: x, y, z of its frame, docs/physics.md section 3).
 struct LumpedSystem {
   Eigen::MatrixXd mass, damping, stiffness, contact_operator;
-  Eigen::VectorXd force;
+  Eigen::VectorXd force, force_sin;
+
+  /// force_sin, or zeros of force's size where it is empty.
+  Eigen::VectorXd sine_force() const { return force_sin.size() == 0 ? Eigen::VectorXd::Zero(force.size()) : force_sin; }
+  /// Sizes of M, C, K, f (and f_sin when given) n x n and n, B (3 elements) x n.
+  bool consistent(Eigen::Index elements) const;
 };
 
 /// The equations of motion of a lumped linear part (its M, C, K, B and excitation).

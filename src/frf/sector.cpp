@@ -6,6 +6,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -217,6 +218,21 @@ SectorLinearPart::SectorLinearPart(Precomputed data, std::vector<SectorContactPa
   for (int n = 1; n <= n_harmonics_; ++n)
     SHROUDSIM_CHECK(dynamic_.count(harmonic_index(n)) == 1,
                     "precomputed data of harmonic index " + std::to_string(harmonic_index(n)));
+}
+
+SectorLinearPart SectorLinearPart::modes_only() const {
+  if (static_.omega.size() == 0)
+    throw std::invalid_argument("the modes-only model needs the modes of harmonic index 0");
+  Precomputed data{static_, dynamic_};
+  auto modal_static = [](const IndexData& d) {
+    return Eigen::MatrixXcd(d.psi * d.omega.cwiseAbs2().cwiseInverse().asDiagonal() * d.psi.adjoint());
+  };
+  data.statics.flex = modal_static(static_);
+  make_hermitian(data.statics.flex);
+  for (auto& [h, d] : data.dynamic) d.flex.setZero();
+  SectorForcing forcing = forcing_;
+  forcing.residual_flexibility = false;
+  return SectorLinearPart(std::move(data), pairs_, forcing, sectors_, n_harmonics_);
 }
 
 bool SectorLinearPart::Precomputed::fits(Eigen::Index k) const {

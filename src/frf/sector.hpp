@@ -148,6 +148,18 @@ class SectorLinearPart : public LinearPart {
     bool fits(Eigen::Index k) const;
   };
   Precomputed precomputed() const { return {static_, dynamic_}; }
+  /// The same model with the modes kept only: no residual flexibility, and the static harmonic
+  /// through index 0's modes (sum_r psi_r psi_r^H / w_r^2) instead of the exact K_0^-1: the
+  /// linear model of a time integration in modal coordinates (forced/modal_wheel.hpp). Needs
+  /// index 0's modes; throws std::invalid_argument without them.
+  SectorLinearPart modes_only() const;
+  /// The data of harmonic index g (0..Nb-1), stored as g or as its conjugate Nb - g (then
+  /// `conjugate`: index g's is the complex conjugate of what is returned); nullptr when the
+  /// model has no modes of g. Index 0's is the static block: its modes, and in flex the static
+  /// flexibility.
+  const IndexData* index_data(int g, bool& conjugate) const;
+  int sectors() const { return sectors_; }
+  const SectorForcing& forcing() const { return forcing_; }
   /// The model from an earlier construction's precomputed data (of the same sector, modes,
   /// pairs and forcing rows): the same receptances, bit for bit, without factorizing; no
   /// static solution is kept (static_solution() is nullptr: the shapes factorize).
@@ -162,9 +174,6 @@ class SectorLinearPart : public LinearPart {
  private:
   /// Q_n(W) (k x k).
   Eigen::MatrixXcd receptance(int n, double w) const;
-  /// The data of harmonic index g (0..Nb-1), stored as g or as its conjugate Nb - g; nullptr
-  /// when the model has no modes of g.
-  const IndexData* index_data(int g, bool& conjugate) const;
   /// The harmonic index of block k of perturbation family p: p + k m mod Nb.
   int family_block_index(int family, int k) const;
 

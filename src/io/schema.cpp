@@ -568,8 +568,10 @@ Schema declare() {
            to_string,
            "frf: how the points are judged (docs/physics.md section 9): hill = Hill's method (any model; with "
            "friction the slider is a state of the eigenproblem, whose size then grows by N per tangential direction "
-           "and pair); shooting = Floquet multipliers of the time integration's period map (lumped models); auto = "
-           "shooting for a lumped model with friction, hill otherwise")
+           "and pair; on an FE sector the modes of every harmonic index 0..Nb/2 are computed for its perturbation "
+           "families); shooting = Floquet multipliers of the time integration's period map (lumped models); auto = "
+           "shooting for a lumped model with friction, hill for other lumped models, none for an FE sector (run.json "
+           "says why)")
       .rule("shooting: a lumped structure (the FE sector has no time integration)",
             [](const Case& c, const StabilityMethod& v) { return v != StabilityMethod::shooting || lumped(c); });
   d.integer("response.shooting_steps", at(&Case::response, &ResponseSection::shooting_steps), 4096, "",

@@ -462,16 +462,46 @@ TEST(Cli, SectorForcedResponseRunsEndToEndWithFullThreeDimensionalContact) {
   // Excitation work = modal viscous + contact dissipation at every point, to the Newton tolerance.
   EXPECT_LT(std::stod(run.substr(at + 28)), 1e-5) << run.substr(at, 60);
   EXPECT_GT(lines_of(slurp(s.dir() / "results" / "sector" / "frf.csv")).size(), 50u);
-  // The sector's stability is not analysed (on this sector, with or without the slider as a
-  // state, it calls 80 Hz, far below resonance, unstable, and its verdicts change with H; nothing
-  // independent decides: docs/physics.md section 9): run.json says so and why, and frf.csv has
-  // no `stable` column rather than claiming anything.
-  const auto stability = nlohmann::json::parse(run)["frf"]["stability"];
+  // With stability_method "auto" the sector's stability is not analysed (it needs the modes of
+  // every harmonic index and, with friction, pencils N x 2 x pairs wider: docs/physics.md section
+  // 9): run.json says so and how to ask for it, and frf.csv has no `stable` column rather than
+  // claiming anything; the forced stage computed the harmonic balance's indices only.
+  const auto j = nlohmann::json::parse(run);
+  const auto stability = j["frf"]["stability"];
   EXPECT_FALSE(stability["available"].get<bool>());
   EXPECT_NE(stability["reason"].get<std::string>().find("FE sector"), std::string::npos);
-  EXPECT_NE(stability["reason"].get<std::string>().find("no independent reference"), std::string::npos);
+  EXPECT_NE(stability["reason"].get<std::string>().find("stability_method = \"hill\""), std::string::npos);
+  EXPECT_EQ(j["frf_model"]["harmonic_indices"], nlohmann::json({1, 2, 3}));
   const auto lines = lines_of(slurp(s.dir() / "results" / "sector" / "frf.csv"));
   EXPECT_EQ(lines[0].find("stable"), std::string::npos) << lines[0];
+}
+
+TEST(Cli, HillOnASectorJudgesEveryPointOverTheModesOfEveryHarmonicIndex) {
+  // stability_method = "hill" on the coarse sector (Nb = 8, full3d friction, H = 3, N = 64): the
+  // forced stage computes the modes of indices 0..4 (the perturbation families), every point is
+  // judged with the slider as a state, and frf.csv's `stable` column is run.json's count. Its
+  // verdicts against an independent reference, the whole wheel's time integration:
+  // tests/forced/test_modal_wheel.cpp.
+  const Scratch s("sector_hill");
+  s.write("case.toml", coarse_sector_case(110.0, 110.2) + "[response]\nstability_method = \"hill\"\n");
+  const CliResult r = s.run("frf case.toml --quiet --no-plots");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(s.dir() / "results" / "sector" / "run.json"));
+  EXPECT_EQ(j["frf_model"]["harmonic_indices"], nlohmann::json({0, 1, 2, 3, 4}));
+  const auto stability = j["frf"]["stability"];
+  ASSERT_TRUE(stability["available"].get<bool>()) << stability.dump();
+  EXPECT_EQ(stability["linearization"], "slider_state");
+  EXPECT_EQ(stability["failed_points"].get<int>(), 0);
+  const auto lines = lines_of(slurp(s.dir() / "results" / "sector" / "frf.csv"));
+  ASSERT_NE(lines[0].find(",stable"), std::string::npos) << lines[0];
+  int unstable = 0;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const char last = lines[i].back();
+    ASSERT_TRUE(last == '0' || last == '1') << lines[i];
+    unstable += last == '0' ? 1 : 0;
+  }
+  EXPECT_EQ(unstable, stability["unstable_points"].get<int>());
+  EXPECT_GT(lines.size(), 5u);
 }
 
 TEST(Cli, ReceptancesAreReusedWhereOnlyTheContactLawChangesAndRecomputedWhereTheirInputsDo) {
