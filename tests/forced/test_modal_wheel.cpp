@@ -277,5 +277,15 @@ TEST(ModalWheel, DISABLED_HillAgainstTheWheelAtSeveralH) {
     hill_against_the_wheel(h, n, 16);
 }
 
+// BENCHMARKS.md's march from rest: the wheel at 80 Hz (H = 3's modes-only model) for up to
+// 20,000 periods (run with --gtest_also_run_disabled_tests).
+TEST(ModalWheel, DISABLED_MarchedFromRestAt80Hz) {
+  FrictionModel m(3, 64);
+  TimeMarchOptions o;
+  o.max_steps = 4'000'000'000LL;
+  const TimeMarchResult tm = march_to_steady_state(m.wheel.system, m.wheel.pairs, contact::Model::full3d, 80.0, o);
+  std::printf("80 Hz: %s (change over the last period %.3e)\n", tm.describe().c_str(), tm.change_one_period);
+}
+
 }  // namespace
 }  // namespace shroudsim::forced
