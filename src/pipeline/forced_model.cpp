@@ -21,6 +21,7 @@
 #include "frf/contact_patches.hpp"
 #include "frf/lumped.hpp"
 #include "frf/sector.hpp"
+#include "forced/stability.hpp"
 #include "frf/static_shroud.hpp"
 #include "io/output.hpp"
 #include "modal/cache.hpp"
@@ -201,9 +202,29 @@ void check_forced_points(const io::Case& c, const mesh::Mesh& mesh) {
   }
 }
 
-bool sector_stability_requested(const io::Case& c) {
+namespace {
+
+/// Hill's method asked for on an FE sector.
+bool sector_hill(const io::Case& c) {
   return c.structure.type == io::StructureType::sector && c.response.stability &&
          c.response.stability_method == io::StabilityMethod::hill;
+}
+
+/// The friction slider's directions: 1 for the 1d laws, 2 otherwise.
+int tangential_directions(const io::Case& c) { return contact::n_directions(c.contact.model) == 1 ? 1 : 2; }
+
+/// With friction the slider state adds N x (tangential directions) x (contact elements) to each
+/// family's pencil. Where the case fixes N and the number of patches (each at least one
+/// element), that lower bound is known before any mode is computed: 0 where it is not.
+long long slider_state_lower_bound(const io::Case& c) {
+  if (c.contact.friction_coefficient <= 0.0 || c.contact.pairs <= 0 || c.hbm.time_samples_auto) return 0;
+  return static_cast<long long>(c.hbm.time_samples) * tangential_directions(c) * c.contact.pairs;
+}
+
+}  // namespace
+
+bool sector_stability_requested(const io::Case& c) {
+  return sector_hill(c) && slider_state_lower_bound(c) <= forced::kMaxSliderStateSize;
 }
 
 std::vector<int> forced_harmonic_indices(const io::Case& c) {
@@ -226,6 +247,12 @@ bool judged_by_shooting(const io::Case& c) {
 
 std::string sector_stability_refusal(const io::Case& c) {
   if (c.structure.type != io::StructureType::sector || sector_stability_requested(c)) return "";
+  if (sector_hill(c))
+    return "not analysed (docs/physics.md section 9): with friction each perturbation family's pencil holds the "
+           "damper position of every time sample, tangential direction and contact element, at least " +
+           std::to_string(slider_state_lower_bound(c)) + " unknowns here (hbm.time_samples x " +
+           std::to_string(tangential_directions(c)) + " x contact.pairs), above the limit of " +
+           std::to_string(forced::kMaxSliderStateSize) + "; fewer samples or pairs bring it within";
   return "not analysed for an FE sector unless asked for (docs/physics.md section 9): response.stability_method = "
          "\"hill\" judges every point over the sector's perturbation families, which needs the modes of every "
          "harmonic index 0..Nb/2 and, with friction, a pencil about N x 2 x pairs wider per family (the default "

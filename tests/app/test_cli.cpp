@@ -502,6 +502,15 @@ TEST(Cli, HillOnASectorJudgesEveryPointOverTheModesOfEveryHarmonicIndex) {
   }
   EXPECT_EQ(unstable, stability["unstable_points"].get<int>());
   EXPECT_GT(lines.size(), 5u);
+  // At N = 512 the damper positions alone would make each pencil 512 x 2 x 3 = 3072 wide, above
+  // the limit: refused before any further mode is computed, and run.json says so.
+  const CliResult big = s.run("frf case.toml --quiet --no-plots --out n512 --set hbm.time_samples=512");
+  ASSERT_EQ(big.status, 0) << big.err;
+  const auto k = nlohmann::json::parse(slurp(s.dir() / "n512" / "run.json"));
+  EXPECT_EQ(k["frf_model"]["harmonic_indices"], nlohmann::json({1, 2, 3}));
+  EXPECT_FALSE(k["frf"]["stability"]["available"].get<bool>());
+  EXPECT_NE(k["frf"]["stability"]["reason"].get<std::string>().find("at least 3072 unknowns"), std::string::npos)
+      << k["frf"]["stability"]["reason"];
 }
 
 TEST(Cli, ReceptancesAreReusedWhereOnlyTheContactLawChangesAndRecomputedWhereTheirInputsDo) {
