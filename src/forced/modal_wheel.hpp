@@ -19,6 +19,7 @@
 // of frf::SectorLinearPart::modes_only() (no residual flexibility, the static harmonic through
 // index 0's modes), which has exactly this linear part.
 #include <Eigen/Core>
+#include <complex>
 #include <vector>
 
 #include "contact/contact_law.hpp"
