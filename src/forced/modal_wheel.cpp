@@ -1,15 +1,13 @@
 #include "forced/modal_wheel.hpp"
 
-#include <array>
 #include <cmath>
 #include <complex>
-#include <map>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 
-#include "forced/element_law.hpp"
 #include "forced/reduced_equations.hpp"
+#include "forced/shooting.hpp"
 #include "frf/sector.hpp"
 
 namespace shroudsim::forced {
@@ -56,6 +54,7 @@ ModalWheel modal_wheel(const frf::SectorLinearPart& sector, const std::vector<co
   const double alpha = 2.0 * std::numbers::pi / nb, zeta = sector.forcing().damping_ratio;
   // The coordinates and the turn of each real mode.
   std::vector<double> omega;
+  std::vector<Complex> turns;
   for (int g = 0; 2 * g <= nb; ++g) {
     const IndexView v = view(sector, g);
     for (Eigen::Index r = 0; r < v.data->omega.size(); ++r) {
@@ -75,7 +74,7 @@ ModalWheel modal_wheel(const frf::SectorLinearPart& sector, const std::vector<co
       }
       for (int part = 0; part < (real_index(g, nb) ? 1 : 2); ++part) {
         w.coordinates.push_back({g, static_cast<int>(r), part});
-        w.turn.push_back(turn);
+        turns.push_back(turn);
         omega.push_back(v.data->omega[r]);
       }
     }
@@ -89,7 +88,7 @@ ModalWheel modal_wheel(const frf::SectorLinearPart& sector, const std::vector<co
   // Each coordinate's value on sector j of a row of the modes' psi: Re(kappa psi e^{i j g alpha}).
   const auto value = [&](Eigen::Index k, Eigen::Index row, int j, const IndexView& v) {
     const ModalWheel::Coordinate& co = w.coordinates[static_cast<std::size_t>(k)];
-    const Complex kappa = real_index(co.index, nb) ? 1.0 / w.turn[static_cast<std::size_t>(k)]
+    const Complex kappa = real_index(co.index, nb) ? 1.0 / turns[static_cast<std::size_t>(k)]
                                                    : (co.part == 0 ? Complex(2.0) : Complex(0.0, 2.0));
     return (kappa * v.psi(row, co.mode) * std::polar(1.0, j * co.index * alpha)).real();
   };
@@ -113,65 +112,19 @@ ModalWheel modal_wheel(const frf::SectorLinearPart& sector, const std::vector<co
 void modal_wheel_state(const ModalWheel& wheel, const frf::SectorLinearPart& sector, ReducedEquations& equations,
                        contact::Model model, const Eigen::VectorXd& x, double frequency_hz, Eigen::VectorXd& u0,
                        Eigen::VectorXd& v0, Eigen::VectorXd& sliders0) {
+  // Every sector's pairs carry the reference pairs' force harmonic n phase-shifted by
+  // e^{i j h_n alpha}; the wheel's periodic state under them and the travelling wave.
   const int nb = wheel.sectors, c = sector.n_contact();
-  const double omega = 2.0 * std::numbers::pi * frequency_hz, alpha = 2.0 * std::numbers::pi / nb;
-  const double zeta = sector.forcing().damping_ratio, scale = equations.excitation_scale();
-  const std::vector<Eigen::VectorXcd> forces = equations.contact_force_harmonics(x);
-  const Eigen::Index n = static_cast<Eigen::Index>(wheel.coordinates.size());
-  // The coordinate of (index, mode, part).
-  std::map<std::array<int, 3>, Eigen::Index> where;
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const ModalWheel::Coordinate& co = wheel.coordinates[static_cast<std::size_t>(k)];
-    where[{co.index, co.mode, co.part}] = k;
-  }
-  u0 = Eigen::VectorXd::Zero(n);
-  v0 = Eigen::VectorXd::Zero(n);
-  const int dirs = contact::n_directions(model) == 1 ? 1 : 2;
-  Eigen::VectorXd f0 = detail::static_load(wheel.pairs, dirs == 1);
-  for (std::size_t h = 0; h < forces.size(); ++h) {
-    const int g = sector.harmonic_index(static_cast<int>(h));
-    const IndexView v = view(sector, g);
-    const double big_w = static_cast<double>(h) * omega;
-    for (Eigen::Index r = 0; r < v.data->omega.size(); ++r) {
-      // The modal amplitude of harmonic h: (conj(E_r) delta_h1 - P_r^H F_h) / den_r.
-      Complex load = h == 1 ? scale * std::conj(v.psi(c + 3, r)) : Complex(0.0);
-      for (Eigen::Index row = 0; row < c; ++row) load -= std::conj(v.psi(row, r)) * forces[h][row];
-      const double wr = v.data->omega[r];
-      const Complex q = load / Complex(wr * wr - big_w * big_w, 2.0 * zeta * wr * big_w);
-      const Complex dq(0.0, big_w);  // d/dt of e^{i h w t}
-      if (real_index(g, nb)) {
-        const Eigen::Index k = where.at({g, static_cast<int>(r), 0});
-        const Complex qt = q * wheel.turn[static_cast<std::size_t>(k)];  // phi q = phi' (turn q)
-        u0[k] += qt.real();
-        v0[k] += (dq * qt).real();
-      } else {
-        // a + i b of the canonical index gets q / 2 (g < Nb/2) or conj(q) / 2 (g > Nb/2).
-        const bool upper = 2 * g > nb;
-        const int canonical = upper ? nb - g : g;
-        const Complex half = upper ? std::conj(q) / 2.0 : q / 2.0,
-                      dhalf = upper ? std::conj(dq * q) / 2.0 : dq * q / 2.0;
-        const Eigen::Index ka = where.at({canonical, static_cast<int>(r), 0}),
-                           kb = where.at({canonical, static_cast<int>(r), 1});
-        u0[ka] += half.real();
-        u0[kb] += half.imag();
-        v0[ka] += dhalf.real();
-        v0[kb] += dhalf.imag();
-      }
-    }
-    // Every sector's pairs: the force harmonic h phase-shifted by j h_h alpha.
+  const double alpha = 2.0 * std::numbers::pi / nb;
+  std::vector<Eigen::VectorXcd> forces = equations.contact_force_harmonics(x);
+  for (std::size_t n = 0; n < forces.size(); ++n) {
+    const int g = sector.harmonic_index(static_cast<int>(n));
+    Eigen::VectorXcd all(static_cast<Eigen::Index>(nb) * c);
     for (int j = 0; j < nb; ++j)
-      f0.segment(static_cast<Eigen::Index>(j) * c, c) += (forces[h] * std::polar(1.0, j * g * alpha)).real();
+      all.segment(static_cast<Eigen::Index>(j) * c, c) = forces[n] * std::polar(1.0, j * g * alpha);
+    forces[n] = std::move(all);
   }
-  const Eigen::VectorXd wc = wheel.system.contact_operator * u0;
-  sliders0.resize(dirs * static_cast<Eigen::Index>(wheel.pairs.size()));
-  for (std::size_t e = 0; e < wheel.pairs.size(); ++e) {
-    const Eigen::Index row = 3 * static_cast<Eigen::Index>(e);
-    const contact::PairParameters& p = wheel.pairs[e];
-    const bool closed = dirs == 1 || p.normal_preload + p.normal_stiffness * wc[row + 2] > 0.0;
-    for (int d = 0; d < dirs; ++d)
-      sliders0[dirs * static_cast<Eigen::Index>(e) + d] =
-          wc[row + d] - (closed ? f0[row + d] / p.tangential_stiffness : 0.0);
-  }
+  periodic_state(wheel.system, wheel.pairs, model, forces, frequency_hz, u0, v0, sliders0);
 }
 
 }  // namespace shroudsim::forced

@@ -19,7 +19,6 @@
 // of frf::SectorLinearPart::modes_only() (no residual flexibility, the static harmonic through
 // index 0's modes), which has exactly this linear part.
 #include <Eigen/Core>
-#include <complex>
 #include <vector>
 
 #include "contact/contact_law.hpp"
@@ -43,10 +42,8 @@ struct ModalWheel {
   struct Coordinate {
     int index = 0, mode = 0, part = 0;
   };
+  /// A mode of a real index (0, Nb/2) is turned by one phase so that it is real.
   std::vector<Coordinate> coordinates;
-  /// Per coordinate: the phase e^{i theta} its mode was turned by, phi' = phi e^{-i theta}, so
-  /// that a mode of a real index (0, Nb/2) is real; 1 for a complex index.
-  std::vector<std::complex<double>> turn;
 };
 
 /// The wheel of `sector` (every index 0..Nb/2 must have modes: the case's harmonic_indices =
@@ -57,12 +54,9 @@ ModalWheel modal_wheel(const frf::SectorLinearPart& sector, const std::vector<co
                        double excitation_scale = 1.0);
 
 /// The wheel's state at t = 0 of the harmonic-balance solution x of `equations` (whose linear
-/// part is `sector`, the one the wheel was built from) at `frequency_hz`: each coordinate from
-/// its modal amplitude under the excitation and the contact force harmonics, every sector's
-/// pairs phase-shifted, and each slider = relative displacement - tangential force / kt at
-/// t = 0 (= the relative displacement where the contact is open), as
-/// forced::harmonic_balance_state does for a lumped model. Not thread-safe (it evaluates the
-/// contact forces through `equations`).
+/// part is `sector`, the one the wheel was built from) at `frequency_hz`: forced::periodic_state
+/// of the wheel under the contact force harmonics, every sector's pairs phase-shifted by
+/// e^{i j h_n alpha}. Not thread-safe (it evaluates the contact forces through `equations`).
 void modal_wheel_state(const ModalWheel& wheel, const frf::SectorLinearPart& sector, ReducedEquations& equations,
                        contact::Model model, const Eigen::VectorXd& x, double frequency_hz, Eigen::VectorXd& u0,
                        Eigen::VectorXd& v0, Eigen::VectorXd& sliders0);

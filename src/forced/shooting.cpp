@@ -6,12 +6,12 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <stdexcept>
 
 #include "forced/element_law.hpp"
 #include "forced/reduced_equations.hpp"
-#include "frf/lumped.hpp"
 
 namespace shroudsim::forced {
 namespace {
@@ -315,26 +315,32 @@ double shooting_work(const LumpedSystem& s, const std::vector<contact::PairParam
   return steps * (2.0 * (d + 1.0) + kShootingMarchPeriods);
 }
 
-void harmonic_balance_state(ReducedEquations& equations, const frf::LumpedLinearPart& lumped,
-                            const std::vector<contact::PairParameters>& pairs, contact::Model model,
-                            const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& u0, Eigen::VectorXd& v0,
-                            Eigen::VectorXd& sliders0) {
+void periodic_state(const LumpedSystem& system, const std::vector<contact::PairParameters>& pairs, contact::Model model,
+                    const std::vector<Eigen::VectorXcd>& forces, double frequency_hz, Eigen::VectorXd& u0,
+                    Eigen::VectorXd& v0, Eigen::VectorXd& sliders0) {
+  using Complex = std::complex<double>;
   const double omega = kTwoPi * frequency_hz;
   const bool one_d = contact::n_directions(model) == 1;
-  // contact_force_harmonics: harmonic 0 without the load the structure already carries.
-  const std::vector<Eigen::VectorXcd> forces = equations.contact_force_harmonics(w);
-  const Eigen::Index n = lumped.mass().rows();
+  const Eigen::Index n = system.mass.rows();
   u0 = Eigen::VectorXd::Zero(n);
   v0 = Eigen::VectorXd::Zero(n);
   Eigen::VectorXd f0 = detail::static_load(pairs, one_d);
   for (std::size_t h = 0; h < forces.size(); ++h) {
     // x(t) = Re sum_h X_h e^{i h w t}: at t = 0 Re X_h, and the velocity Re(i h w X_h).
-    const Eigen::VectorXcd u = lumped.displacement(static_cast<int>(h), omega, forces[h]);
+    const double big_w = static_cast<double>(h) * omega;
+    const Eigen::MatrixXcd dynamic = system.stiffness.cast<Complex>() - big_w * big_w * system.mass.cast<Complex>() +
+                                     Complex(0.0, big_w) * system.damping.cast<Complex>();
+    Eigen::VectorXcd f = -system.contact_operator.transpose().cast<Complex>() * forces[h];
+    if (h == 1) {  // f cos + f_s sin = Re((f - i f_s) e^{i w t})
+      f += system.force.cast<Complex>();
+      if (system.force_sin.size() > 0) f -= Complex(0.0, 1.0) * system.force_sin.cast<Complex>();
+    }
+    const Eigen::VectorXcd u = Eigen::PartialPivLU<Eigen::MatrixXcd>(dynamic).solve(f);
     u0 += u.real();
-    v0 -= static_cast<double>(h) * omega * u.imag();
+    v0 -= big_w * u.imag();
     f0 += forces[h].real();
   }
-  const Eigen::VectorXd wc = lumped.contact_operator() * u0;
+  const Eigen::VectorXd wc = system.contact_operator * u0;
   const int dirs = one_d ? 1 : 2;
   sliders0.resize(dirs * static_cast<Eigen::Index>(pairs.size()));
   for (std::size_t e = 0; e < pairs.size(); ++e) {
@@ -344,6 +350,14 @@ void harmonic_balance_state(ReducedEquations& equations, const frf::LumpedLinear
       sliders0[dirs * static_cast<Eigen::Index>(e) + d] =
           wc[row + d] - (closed ? f0[row + d] / pairs[e].tangential_stiffness : 0.0);
   }
+}
+
+void harmonic_balance_state(ReducedEquations& equations, const LumpedSystem& system,
+                            const std::vector<contact::PairParameters>& pairs, contact::Model model,
+                            const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& u0, Eigen::VectorXd& v0,
+                            Eigen::VectorXd& sliders0) {
+  // contact_force_harmonics: harmonic 0 without the load the structure already carries.
+  periodic_state(system, pairs, model, equations.contact_force_harmonics(w), frequency_hz, u0, v0, sliders0);
 }
 
 }  // namespace shroudsim::forced

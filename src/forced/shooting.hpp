@@ -22,10 +22,6 @@
 #include "forced/stability.hpp"
 #include "forced/time_march.hpp"
 
-namespace shroudsim::frf {
-class LumpedLinearPart;
-}
-
 namespace shroudsim::forced {
 
 class ReducedEquations;
@@ -106,11 +102,19 @@ ShootingResult shooting_floquet(const LumpedSystem& system, const std::vector<co
 double shooting_work(const LumpedSystem& system, const std::vector<contact::PairParameters>& pairs,
                      contact::Model model, double frequency_hz, const ShootingOptions& options = {});
 
-/// The state at t = 0 of the harmonic-balance solution w of `equations` (a lumped model): u and
-/// v from every DOF's harmonics, each slider from the contact force's harmonics at t = 0
-/// (slider = relative displacement - force / kt; = relative displacement where the contact is
-/// open). Not thread-safe (it evaluates the contact forces through `equations`).
-void harmonic_balance_state(ReducedEquations& equations, const frf::LumpedLinearPart& lumped,
+/// The state at t = 0 of a periodic motion of `system` whose contact elements carry the force
+/// harmonics `forces` (F_n, n = 0..H, 3 per element; harmonic 0 without the load the structure
+/// already carries): u and v from U_n = (K - (n w)^2 M + i n w C)^-1 (f_n - B^T F_n), with
+/// f_1 = force - i force_sin; each slider = relative displacement - tangential force / kt at
+/// t = 0 (= the relative displacement where the contact is open).
+void periodic_state(const LumpedSystem& system, const std::vector<contact::PairParameters>& pairs, contact::Model model,
+                    const std::vector<Eigen::VectorXcd>& forces, double frequency_hz, Eigen::VectorXd& u0,
+                    Eigen::VectorXd& v0, Eigen::VectorXd& sliders0);
+
+/// periodic_state of the harmonic-balance solution w of `equations`, whose contact elements are
+/// `system`'s (a lumped model, or a whole wheel's equations). Not thread-safe (it evaluates the
+/// contact forces through `equations`).
+void harmonic_balance_state(ReducedEquations& equations, const LumpedSystem& system,
                             const std::vector<contact::PairParameters>& pairs, contact::Model model,
                             const Eigen::VectorXd& w, double frequency_hz, Eigen::VectorXd& u0, Eigen::VectorXd& v0,
                             Eigen::VectorXd& sliders0);

@@ -145,7 +145,7 @@ std::vector<forced::FloquetResult> shooting_stability(
   // The states from the harmonics in order (the equations are not shared between threads).
   for (std::size_t i = 0; i < n; ++i)
     if (judged(i))
-      forced::harmonic_balance_state(equations, lumped, pairs, law, response.points[i].x, response.points[i].lambda,
+      forced::harmonic_balance_state(equations, system, pairs, law, response.points[i].x, response.points[i].lambda,
                                      u0[i], v0[i], d0[i]);
   std::vector<forced::ShootingResult> shots(n);
   errors.assign(n, std::string());

@@ -709,25 +709,8 @@ TEST_P(CyclicStability, WithTheSliderAsAStateTheFamiliesGiveTheWheelsExponentsAn
     EXPECT_EQ(neutral_a, !p.stick_slip) << p.name();
     EXPECT_EQ(neutral_b, !p.stick_slip) << p.name();
     compare(p, an, bn, kSameSpectrumTol, "slider state");
-    // The wheel's state at t = 0 (harmonic_balance_state's, with this excitation): the harmonics
-    // U_n = (K - (n w)^2 M + i n w C)^-1 (f_n - B^T F_n), each slider = x - F_x / kt (1d: always closed).
-    const auto& full = *s_->full;
-    const std::vector<Eigen::VectorXcd> forces = s_->full_equations->contact_force_harmonics(xw);
-    Eigen::VectorXd u0 = Eigen::VectorXd::Zero(2 * nb), v0 = u0, fx = Eigen::VectorXd::Zero(3 * nb);
-    for (std::size_t n = 0; n < forces.size(); ++n) {
-      const double big_w = static_cast<double>(n) * 2 * kPi * f;
-      const Eigen::MatrixXcd dynamic = full.stiffness().cast<Complex>() - big_w * big_w * full.mass().cast<Complex>() +
-                                       Complex(0.0, big_w) * full.damping().cast<Complex>();
-      Eigen::VectorXcd load = -full.contact_operator().transpose().cast<Complex>() * forces[n];
-      if (n == 1) load += system.force.cast<Complex>() - Complex(0.0, 1.0) * system.force_sin.cast<Complex>();
-      const Eigen::VectorXcd un = dynamic.partialPivLu().solve(load);
-      u0 += un.real();
-      v0 -= big_w * un.imag();
-      fx += forces[n].real();
-    }
-    const Eigen::VectorXd wc = full.contact_operator() * u0;
-    Eigen::VectorXd d0(nb);
-    for (int j = 0; j < nb; ++j) d0[j] = wc[3 * j] - fx[3 * j] / s_->pair.tangential_stiffness;
+    Eigen::VectorXd u0, v0, d0;
+    harmonic_balance_state(*s_->full_equations, system, pairs, contact::Model::one_d, xw, f, u0, v0, d0);
     const ShootingResult sh = shooting_floquet(system, pairs, contact::Model::one_d, f, u0, v0, d0);
     worst_start = std::max(worst_start, sh.start_mismatch);
     std::printf("%s: shooting start mismatch %.3e, spectral radius %.6f, Hill exp(max_real T) %.6f\n", p.name().c_str(),

@@ -394,9 +394,8 @@ TEST(Stability, WhereFrictionGivesSeveralSolutionsTheTimeIntegrationSettlesOnASt
 /// The shooting's state at t = 0 of the solution w, and its result.
 ShootingResult shoot(ReducedEquations& eq, const Lumped& l, const Eigen::VectorXd& w, double f) {
   const LumpedSystem system = system_of(l);
-  const auto& lin = static_cast<const frf::LumpedLinearPart&>(*l.model.linear);
   Eigen::VectorXd u0, v0, d0;
-  harmonic_balance_state(eq, lin, l.model.pairs, l.options.law.model, w, f, u0, v0, d0);
+  harmonic_balance_state(eq, system, l.model.pairs, l.options.law.model, w, f, u0, v0, d0);
   return shooting_floquet(system, l.model.pairs, l.options.law.model, f, u0, v0, d0);
 }
 
