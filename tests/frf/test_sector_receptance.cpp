@@ -184,7 +184,13 @@ TEST(SectorReceptance, ScalingTheForceIsBuildingWithTheScaledForce) {
   ASSERT_EQ(p.dynamic.size(), q.dynamic.size());
   for (const auto& [h, d] : q.dynamic) {
     near(p.dynamic.at(h).psi, d.psi, "psi of index " + std::to_string(h));
-    near(p.dynamic.at(h).flex, d.flex, "flex of index " + std::to_string(h));
+    // The residual flexibility is the static solution less the kept modes' part, and the two
+    // are solved with differently rounded right-hand sides (a f against f): its round-off is
+    // relative to those terms, not to their difference (2e-3 to 5e-3 of them here: measured
+    // 1.0e-12 of the difference on one machine, 2e-15 of the terms).
+    const Eigen::MatrixXcd kept = d.psi * d.omega.cwiseAbs2().cwiseInverse().asDiagonal() * d.psi.adjoint();
+    const double terms = kept.norm() + (kept + d.flex).norm();
+    EXPECT_LE((p.dynamic.at(h).flex - d.flex).norm(), kRoundOff * terms) << "flex of index " << h;
   }
   const double w = 0.7 * bases.at(3).omega[0];
   for (int n : {0, 1, 2}) {
