@@ -20,7 +20,10 @@ struct ElementLaw {
   bool one_d = false, coupled = true;
 
   // w: x, y, z of the element; d: slider (x, y), updated; f: force (Tx, Ty, N).
-  void force(const double* w, double* d, double* f) const {
+  // at_limit (bit k: tangential direction k; the coupled law: any bit): the slider is put on
+  // the friction limit along the trial force even where that force lies inside it (the
+  // shooting's differences at a sliding contact, forced/shooting.cpp).
+  void force(const double* w, double* d, double* f, unsigned at_limit = 0) const {
     const double kt = p.tangential_stiffness, mu = p.friction_coefficient;
     const double n = one_d ? std::max(0.0, p.normal_preload)
                            : std::max(0.0, p.normal_preload + p.normal_stiffness * w[2]);
@@ -35,7 +38,7 @@ struct ElementLaw {
     if (one_d || !coupled) {
       for (int k = 0; k < (one_d ? 1 : 2); ++k) {
         const double t = kt * (w[k] - d[k]);
-        if (std::abs(t) <= limit) {
+        if ((std::abs(t) <= limit && ((at_limit >> k) & 1U) == 0) || t == 0.0) {
           f[k] = t;
         } else {
           f[k] = std::copysign(limit, t);
@@ -47,7 +50,7 @@ struct ElementLaw {
     }
     const double tx = kt * (w[0] - d[0]), ty = kt * (w[1] - d[1]);
     const double t = std::hypot(tx, ty);
-    if (t <= limit) {
+    if (t <= limit && (at_limit == 0 || t == 0.0)) {
       f[0] = tx;
       f[1] = ty;
     } else {
