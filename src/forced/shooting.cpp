@@ -48,34 +48,16 @@ class PeriodMap {
   }
   Eigen::Index size() const { return 2 * n_ + dirs_ * static_cast<Eigen::Index>(laws_.size()); }
 
-  /// The sliders of each element the law moves at the states z (columns) themselves, as bits
-  /// per tangential direction (ElementLaw::force's at_limit), over all columns: those at the
-  /// friction limit, sliding there.
-  std::vector<unsigned> sliding(const Eigen::MatrixXd& z) const {
-    std::vector<unsigned> out(laws_.size(), 0U);
-    double f[3];
-    for (Eigen::Index j = 0; j < z.cols(); ++j) {
-      const Eigen::VectorXd wc = s_.contact_operator * z.col(j).head(n_);
-      for (std::size_t e = 0; e < laws_.size(); ++e) {
-        const Eigen::Index at = 2 * n_ + dirs_ * static_cast<Eigen::Index>(e);
-        double d[2] = {z(at, j), dirs_ == 2 ? z(at + 1, j) : 0.0};
-        const double before[2] = {d[0], d[1]};
-        laws_[e].force(wc.data() + 3 * static_cast<Eigen::Index>(e), d, f);
-        for (int k = 0; k < dirs_; ++k)
-          if (d[k] != before[k]) out[e] |= 1U << k;
-      }
-    }
-    return out;
-  }
-
-  /// One period from each column of z. at_limit (per element, ElementLaw::force's bits): the
-  /// sliders put on the friction limit at t = 0 whatever the column's trial force.
-  Eigen::MatrixXd apply(const Eigen::MatrixXd& z, const std::vector<unsigned>* at_limit = nullptr) const {
+  /// One period from each column of z. sliding_at_limit: the sliders the law moves at t = 0 in
+  /// any column (those on the friction limit, sliding there) are put on the limit in every
+  /// column, whatever its trial force (ElementLaw::force's at_limit; map_and_derivative).
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& z, bool sliding_at_limit = false) const {
     const Eigen::Index m = z.cols(), c = 3 * static_cast<Eigen::Index>(laws_.size());
     Eigen::MatrixXd u = z.topRows(n_), v = w_ * z.middleRows(n_, n_);
     Eigen::MatrixXd slider = Eigen::MatrixXd::Zero(2 * static_cast<Eigen::Index>(laws_.size()), m);
+    const auto slider_rows = [&](Eigen::Index e) { return z.middleRows(2 * n_ + dirs_ * e, dirs_); };
     for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(laws_.size()); ++e)
-      slider.middleRows(2 * e, dirs_) = z.middleRows(2 * n_ + dirs_ * e, dirs_);
+      slider.middleRows(2 * e, dirs_) = slider_rows(e);
     Eigen::MatrixXd wc(c, m), fc(c, m), a(n_, m), a1(n_, m), v_half(n_, m);
     const auto contact_force = [&](const std::vector<unsigned>* limit) {
       wc.noalias() = s_.contact_operator.lazyProduct(u);
@@ -85,7 +67,22 @@ class PeriodMap {
                          limit != nullptr ? (*limit)[e] : 0U);
       fc.colwise() -= f_static_;
     };
-    contact_force(at_limit);
+    contact_force(nullptr);
+    if (sliding_at_limit) {
+      std::vector<unsigned> at_limit(laws_.size(), 0U);
+      bool any = false;
+      for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(laws_.size()); ++e)
+        for (Eigen::Index k = 0; k < dirs_; ++k)
+          if (slider.row(2 * e + k) != slider_rows(e).row(k)) {
+            at_limit[static_cast<std::size_t>(e)] |= 1U << k;
+            any = true;
+          }
+      if (any) {
+        for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(laws_.size()); ++e)
+          slider.middleRows(2 * e, dirs_) = slider_rows(e);
+        contact_force(&at_limit);
+      }
+    }
     a = s_.force.replicate(1, m) - s_.stiffness * u - s_.contact_operator.transpose() * fc - s_.damping * v;
     a = mass_llt_.solve(a);
     for (long long k = 0; k < steps_; ++k) {
@@ -133,8 +130,8 @@ double state_size(const Eigen::VectorXd& z) { return std::max(z.lpNorm<Eigen::In
 /// inside the limit sticks the slider for a whole first step (a force change of kt h for dt),
 /// where the continuous motion sticks for a time of order h and changes the force by O(h^2).
 /// The two one-sided differences then differ by about kt dt / (m w), whatever h: on stress
-/// model 10 (kt / k = 9e3), multipliers -3.45 forward and 2.81 backward where perturbed
-/// motions decay by 0.47 a period. So every difference keeps the sliders that slide at z (or
+/// model 10 (kt / k = 9e3), spectral radii 3.45 forward and 2.81 backward where perturbed
+/// motions decay by about 0.45 a period. So every difference keeps the sliders that slide at z (or
 /// that any difference pushes past the limit) on the limit at t = 0, as the continuous motion
 /// does: the derivative of the sliding motion, 0.467 there.
 Eigen::VectorXd map_and_derivative(const PeriodMap& map, const Eigen::VectorXd& z, Eigen::MatrixXd& monodromy) {
@@ -142,8 +139,7 @@ Eigen::VectorXd map_and_derivative(const PeriodMap& map, const Eigen::VectorXd& 
   const double h = kShootingStep * state_size(z);
   Eigen::MatrixXd batch = z.replicate(1, d + 1);
   for (Eigen::Index i = 0; i < d; ++i) batch(i, 1 + i) += h;
-  const std::vector<unsigned> at_limit = map.sliding(batch);
-  const Eigen::MatrixXd out = map.apply(batch, &at_limit);
+  const Eigen::MatrixXd out = map.apply(batch, true);
   monodromy.resize(d, d);
   for (Eigen::Index i = 0; i < d; ++i) monodromy.col(i) = (out.col(1 + i) - out.col(0)) / h;
   return out.col(0);
