@@ -114,7 +114,8 @@ struct SliderPencil {
 };
 SliderPencil slider_state_pencil(const Eigen::MatrixXcd& a0, const Eigen::MatrixXcd& a1, const Eigen::MatrixXd& a2,
                                  const Eigen::MatrixXcd& phi, const std::vector<const Eigen::MatrixXcd*>& r, int h,
-                                 int c, int nd, double omega, const ContactMemory& memory) {
+                                 int c, int nd, double omega, const ContactMemory& memory,
+                                 const Eigen::MatrixXcd& correction) {
   const Complex i1(0.0, 1.0);
   const int np = static_cast<int>(memory.pairs.size());
   const int nt = memory.model == contact::Model::one_d ? 1 : 2;
@@ -150,6 +151,8 @@ SliderPencil slider_state_pencil(const Eigen::MatrixXcd& a0, const Eigen::Matrix
       for (int k = -h; k <= h; ++k)
         for (int l = 0; l < n; ++l) sm(wi(k, p, i), si(p, i, l)) = pair.tangential_stiffness / n * std::conj(e(k, l));
   }
+  // The coarse memory's correction to the harmonic balance's dF/dW is memoryless (ContactMemory).
+  if (correction.size() > 0) d0 += correction;
   // W = Wq q + Ws sigma: (I + R D0) W = Phi q + R S sigma.
   Eigen::MatrixXcd wq = phi, ws = Eigen::MatrixXcd::Zero(ne, ns);
   bool with_r = false;
@@ -280,6 +283,13 @@ linalg::DenseEigen pencil_eigen(const SliderPencil& pencil) {
 }
 }  // namespace
 
+int memory_samples(int requested, int time_samples, int harmonics, int dampers) {
+  const int least = 2 * harmonics + 1;
+  if (requested > 0) return std::min(std::max(requested, least), time_samples);
+  if (dampers <= 0 || static_cast<long long>(time_samples) * dampers <= kMaxMemoryUnknowns) return time_samples;
+  return std::min(time_samples, std::max(least, kMaxMemoryUnknowns / dampers));
+}
+
 bool ContactMemory::carries_memory() const {
   for (const auto& pair : steps)
     for (const contact::SampleStep& st : pair)
@@ -287,12 +297,34 @@ bool ContactMemory::carries_memory() const {
   return false;
 }
 
-ContactMemory contact_memory(ReducedEquations& equations, const Eigen::VectorXd& w) {
+ContactMemory contact_memory(ReducedEquations& equations, const Eigen::VectorXd& w, int samples,
+                             const std::vector<Eigen::MatrixXd>* jacobian) {
   ContactMemory out;
   hbm::ContactEvaluator& contacts = equations.contacts();
   out.model = contacts.options().law.model;
   out.pairs = contacts.pairs();
-  out.steps = contacts.sample_steps(w);
+  if (samples <= 0 || samples >= contacts.options().n_time_samples) {
+    out.steps = contacts.sample_steps(w);
+    return out;
+  }
+  // The same law replayed at `samples` points on the same harmonics (a serial evaluator of its
+  // own: this one may be shared).
+  hbm::ContactEvaluatorOptions options = contacts.options();
+  options.n_time_samples = samples;
+  options.threads = 1;
+  options.measure_plans = false;
+  options.jacobian = hbm::JacobianMethod::analytic;
+  hbm::ContactEvaluator coarse(options, out.pairs);
+  out.steps = coarse.sample_steps(w);
+  Eigen::VectorXd f;
+  std::vector<Eigen::MatrixXd> coarse_jacobian;
+  coarse.evaluate(w, f, &coarse_jacobian);
+  const std::vector<Eigen::MatrixXd> fine = jacobian != nullptr ? *jacobian : equations.contact_jacobian(w);
+  out.correction.resize(fine.size());
+  for (std::size_t p = 0; p < fine.size(); ++p) {
+    out.correction[p] = fine[p] - coarse_jacobian[p];
+    if (!out.correction[p].allFinite()) throw NumericalError("the coarse memory's contact Jacobian is not finite");
+  }
   return out;
 }
 
@@ -396,10 +428,13 @@ FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::Harmon
       t_inv(is, row(n)) = i1, t_inv(is, row(-n)) = -i1;
     }
   }
-  // (Not needed with the slider as a state, which takes the law's steps instead.)
-  Eigen::MatrixXcd dx = Eigen::MatrixXcd::Zero(ne, ne);
-  for (int p = 0; memory == nullptr && p < pairs; ++p) {
-    const Eigen::MatrixXcd local = t * blocks[static_cast<std::size_t>(p)].cast<Complex>() * t_inv;
+  // With the slider as a state the law's steps replace it, but for the coarse memory's
+  // correction (ContactMemory::correction), which enters the same way.
+  const std::vector<Eigen::MatrixXd>* d_blocks = memory == nullptr ? &blocks : &memory->correction;
+  const bool with_dx = memory == nullptr || !memory->correction.empty();
+  Eigen::MatrixXcd dx = Eigen::MatrixXcd::Zero(with_dx ? ne : 0, with_dx ? ne : 0);
+  for (int p = 0; with_dx && p < pairs; ++p) {
+    const Eigen::MatrixXcd local = t * (*d_blocks)[static_cast<std::size_t>(p)].cast<Complex>() * t_inv;
     for (int d1 = 0; d1 < nd; ++d1)
       for (int k1 = -h; k1 <= h; ++k1)
         for (int d2 = 0; d2 < nd; ++d2)
@@ -443,7 +478,7 @@ FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::Harmon
       std::vector<const Eigen::MatrixXcd*> r(static_cast<std::size_t>(nk), nullptr);
       for (int k = -h; k <= h; ++k)
         if (form(k).R.size() > 0 && !form(k).R.isZero(0.0)) r[static_cast<std::size_t>(k + h)] = &form(k).R;
-      solver = pencil_eigen(slider_state_pencil(a0, a1, a2, phi, r, h, c, nd, omega, *memory));
+      solver = pencil_eigen(slider_state_pencil(a0, a1, a2, phi, r, h, c, nd, omega, *memory, dx));
     } else {
       // E = D (I + R D)^-1 = (I + D R)^-1 D, R block diagonal over k.
       Eigen::MatrixXcd dr = Eigen::MatrixXcd::Zero(ne, ne);

@@ -74,6 +74,17 @@ constexpr int kMaxCondensedSize = 600;
 /// not analysed.
 constexpr int kMaxSliderStateSize = 1200;
 
+/// The damper positions (slider-state unknowns) the automatic memory sampling allows
+/// (memory_samples): kMaxSliderStateSize less room for the companion's unknowns (the default
+/// sector's families have 2 s = 198 at 80 Hz).
+constexpr int kMaxMemoryUnknowns = 1000;
+
+/// The time samples of the slider state (response.stability_samples): `requested` (0: automatic)
+/// at least 2H + 1 and at most the harmonic balance's N; automatic: N where N x dampers (pairs x
+/// tangential directions) fits within kMaxMemoryUnknowns, else the most that fit, at least
+/// 2H + 1. docs/physics.md section 9, "Memory samples".
+int memory_samples(int requested, int time_samples, int harmonics, int dampers);
+
 /// The friction law's memory at a solution, for Hill's method with the slider as a state
 /// (docs/physics.md section 9, "Friction: the slider as a state"): each pair's samples'
 /// recursion d(l) = a d(l-1) + b u(l) + c u(l-1) (contact::SampleStep). A perturbation
@@ -84,14 +95,25 @@ constexpr int kMaxSliderStateSize = 1200;
 struct ContactMemory {
   contact::Model model = contact::Model::full3d;
   std::vector<contact::PairParameters> pairs;
-  std::vector<std::vector<contact::SampleStep>> steps;  ///< per pair, N samples
+  std::vector<std::vector<contact::SampleStep>> steps;  ///< per pair, the memory's samples
+  /// Where the memory is sampled more coarsely than the harmonic balance (contact_memory's
+  /// `samples`): per pair (pair_layout order), the harmonic balance's dF/dW minus that of the
+  /// coarse samples' periodic law. It joins the memoryless part of the pencil, so that at
+  /// lambda = 0 the pencil is still the harmonic balance's own linearization (a fold's exponent
+  /// crosses zero where the traced curve folds). Empty at the harmonic balance's N.
+  std::vector<Eigen::MatrixXd> correction;
   /// A sample whose damper depends on the sample before (a stick run, a coupled slip, the
   /// motion's previous sample in an exact_linear step): without any, the law is memoryless
   /// and the harmonic balance's dF/dW is exact.
   bool carries_memory() const;
 };
-/// The memory of the contacts of `equations` at w.
-ContactMemory contact_memory(ReducedEquations& equations, const Eigen::VectorXd& w);
+/// The memory of the contacts of `equations` at w, sampled at the harmonic balance's N or, with
+/// 0 < samples < N, at `samples` points of the period (the law replayed on the same harmonics,
+/// docs/physics.md section 9, "Memory samples"): the pencil then has samples instead of N damper
+/// positions per pair and tangential direction. `jacobian`: the harmonic balance's dF/dW blocks
+/// at w (ReducedEquations::contact_jacobian), needed for the correction when samples < N.
+ContactMemory contact_memory(ReducedEquations& equations, const Eigen::VectorXd& w, int samples = 0,
+                             const std::vector<Eigen::MatrixXd>* jacobian = nullptr);
 
 enum class ExponentSelection { symmetry, imaginary };
 

@@ -102,6 +102,8 @@ struct ResponseSection {
   StabilityMethod stability_method;  ///< Hill's method or shooting (automatic: by the model)
   int shooting_steps;                ///< shooting: least integration steps per excitation period
   double shooting_work;              ///< shooting: work bound of one curve [state-steps]
+  /// hill with friction: time samples of the slider state (0: "auto", forced::memory_samples)
+  int stability_samples = 0;
 };
 
 /// A lumped contact element: one DOF per direction (-1: absent), to ground or to other DOFs.

@@ -583,6 +583,15 @@ Schema declare() {
            "of the time integration advanced one step): a curve that could need more is judged at every k-th point, "
            "the smallest k within the bound (run.json frf.stability.work, stride)")
       .within(1e5, End::closed, 1e12, End::closed);
+  d.integer("response.stability_samples", at(&Case::response, &ResponseSection::stability_samples), 0, "",
+            "hill with friction: time samples of the slider state (damper positions per pair and tangential "
+            "direction), at most hbm.time_samples; auto = hbm.time_samples where the damper positions fit within "
+            "1000, else the most that fit (the default sector: 100 of 512); at lambda = 0 the problem is the "
+            "harmonic balance's linearization at any count; the verdicts' error against it: docs/physics.md section 9")
+      .range(3, 65536)
+      .or_word({"auto", "\"auto\" or an integer >= 3", [](Case& c) { c.response.stability_samples = 0; },
+                [](const Case& c) { return c.response.stability_samples == 0; }},
+               true);
   d.numbers("response.shapes_at_hz", at(&Case::response, &ResponseSection::shapes_at_hz), {}, "Hz",
             "frf: further frequencies of shapes and contact maps (one per crossing of the curve)")
       .rule("every frequency > 0 and finite", [](const Case&, const std::vector<double>& v) {

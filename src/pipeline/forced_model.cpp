@@ -213,12 +213,17 @@ bool sector_hill(const io::Case& c) {
 /// The friction slider's directions: 1 for the 1d laws, 2 otherwise.
 int tangential_directions(const io::Case& c) { return contact::n_directions(c.contact.model) == 1 ? 1 : 2; }
 
-/// With friction the slider state adds N x (tangential directions) x (contact elements) to each
-/// family's pencil. Where the case fixes N and the number of patches (each at least one
-/// element), that lower bound is known before any mode is computed: 0 where it is not.
+/// With friction the slider state adds (memory samples) x (tangential directions) x (contact
+/// elements) to each family's pencil (forced::memory_samples). Where the case fixes N, H and the
+/// number of patches (each at least one element), that lower bound is known before any mode is
+/// computed: 0 where it is not.
 long long slider_state_lower_bound(const io::Case& c) {
-  if (c.contact.friction_coefficient <= 0.0 || c.contact.pairs <= 0 || c.hbm.time_samples_auto) return 0;
-  return static_cast<long long>(c.hbm.time_samples) * tangential_directions(c) * c.contact.pairs;
+  if (c.contact.friction_coefficient <= 0.0 || c.contact.pairs <= 0 || c.hbm.time_samples_auto || c.hbm.harmonics_auto)
+    return 0;
+  const int dampers = tangential_directions(c) * c.contact.pairs;
+  return static_cast<long long>(
+             forced::memory_samples(c.response.stability_samples, c.hbm.time_samples, c.hbm.harmonics, dampers)) *
+         dampers;
 }
 
 }  // namespace
@@ -249,8 +254,8 @@ std::string sector_stability_refusal(const io::Case& c) {
   if (c.structure.type != io::StructureType::sector || sector_stability_requested(c)) return "";
   if (sector_hill(c))
     return "not analysed (docs/physics.md section 9): with friction each perturbation family's pencil holds the "
-           "damper position of every time sample, tangential direction and contact element, at least " +
-           std::to_string(slider_state_lower_bound(c)) + " unknowns here (hbm.time_samples x " +
+           "damper position of every memory sample, tangential direction and contact element, at least " +
+           std::to_string(slider_state_lower_bound(c)) + " unknowns here (response.stability_samples x " +
            std::to_string(tangential_directions(c)) + " x contact.pairs), above the limit of " +
            std::to_string(forced::kMaxSliderStateSize) + "; fewer samples or pairs bring it within";
   return "not analysed for an FE sector unless asked for (docs/physics.md section 9): response.stability_method = "

@@ -75,9 +75,10 @@ void write_frf_csv(const std::filesystem::path& file, const forced::FrequencyRes
 /// Hill's Floquet exponents of every point (forced/stability.hpp); errors[i] says why point i
 /// was not analysed.
 std::vector<forced::FloquetResult> hill_stability(const forced::FrequencyResponse& response,
-                                                  forced::ReducedEquations& equations, int threads,
+                                                  forced::ReducedEquations& equations, int threads, int memory_samples,
                                                   std::vector<std::string>& errors,
                                                   const std::vector<char>* only = nullptr) {
+  const log::Stopwatch clock;
   const std::size_t n = response.points.size();
   std::vector<forced::FloquetResult> out(n);
   errors.assign(n, std::string());
@@ -100,7 +101,9 @@ std::vector<forced::FloquetResult> hill_stability(const forced::FrequencyRespons
       jacobians[i].clear();
       try {
         jacobians[i] = equations.contact_jacobian(response.points[points[first + i]].x);
-        if (with_memory) memories[i] = forced::contact_memory(equations, response.points[points[first + i]].x);
+        if (with_memory)
+          memories[i] =
+              forced::contact_memory(equations, response.points[points[first + i]].x, memory_samples, &jacobians[i]);
       } catch (const NumericalError& e) {
         errors[points[first + i]] = e.what();
       }
@@ -118,6 +121,9 @@ std::vector<forced::FloquetResult> hill_stability(const forced::FrequencyRespons
         errors[k] = e.what();
       }
     });
+    if (points.size() > kBatch)
+      log::info("frf: stability of " + std::to_string(first + count) + " of " + std::to_string(points.size()) +
+                " points (" + io::format_number(clock.seconds()) + " s)");
   }
   return out;
 }
@@ -267,8 +273,13 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   s["requested"] = io::to_string(c.response.stability_method);
   // With friction Hill's method takes the slider as a state (forced::ContactMemory).
   s["linearization"] = friction ? "slider_state" : "harmonic_balance";
+  // The slider state's time samples (response.stability_samples; docs/physics.md section 9).
+  const hbm::ContactEvaluatorOptions& eo = evaluator.options();
+  const int samples = forced::memory_samples(c.response.stability_samples, eo.n_time_samples, eo.n_harmonics,
+                                             static_cast<int>(pairs.size()) * (law == contact::Model::one_d ? 1 : 2));
+  if (friction && law != contact::Model::one_d_exact) s["memory_samples"] = samples;
   if (!shooting) {
-    std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, errors);
+    std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, samples, errors);
     report_stability(s, hill, errors, response, "hill");
     s["seconds"] = clock.seconds();
     return hill;
@@ -288,7 +299,8 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   const std::size_t stride = (judged_by_shooting.size() + kHillComparisonPoints - 1) / kHillComparisonPoints;
   for (std::size_t k = 0; k < judged_by_shooting.size(); k += std::max<std::size_t>(stride, 1))
     compared[judged_by_shooting[k]] = 1;
-  const std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, errors, &compared);
+  const std::vector<forced::FloquetResult> hill =
+      hill_stability(response, equations, threads, samples, errors, &compared);
   int hill_unstable = 0, disagree = 0, judged = 0;
   for (std::size_t i = 0; i < out.size(); ++i) {
     if (!hill[i].available || !out[i].available) continue;

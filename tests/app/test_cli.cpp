@@ -502,9 +502,20 @@ TEST(Cli, HillOnASectorJudgesEveryPointOverTheModesOfEveryHarmonicIndex) {
   }
   EXPECT_EQ(unstable, stability["unstable_points"].get<int>());
   EXPECT_GT(lines.size(), 5u);
-  // At N = 512 the damper positions alone would make each pencil 512 x 2 x 3 = 3072 wide, above
-  // the limit: refused before any further mode is computed, and run.json says so.
-  const CliResult big = s.run("frf case.toml --quiet --no-plots --out n512 --set hbm.time_samples=512");
+  // The slider state at the harmonic balance's N = 64 (3 x 2 x 64 damper positions fit), or at
+  // the samples asked for (response.stability_samples), every point judged either way.
+  EXPECT_EQ(stability["memory_samples"].get<int>(), 64);
+  const CliResult coarse = s.run("frf case.toml --quiet --no-plots --out m32 --set response.stability_samples=32");
+  ASSERT_EQ(coarse.status, 0) << coarse.err;
+  const auto m32 = nlohmann::json::parse(slurp(s.dir() / "m32" / "run.json"))["frf"]["stability"];
+  ASSERT_TRUE(m32["available"].get<bool>()) << m32.dump();
+  EXPECT_EQ(m32["memory_samples"].get<int>(), 32);
+  EXPECT_EQ(m32["failed_points"].get<int>(), 0);
+  // At N = 512 with the slider state at every sample the damper positions alone would make each
+  // pencil 512 x 2 x 3 = 3072 wide, above the limit: refused before any further mode is computed,
+  // and run.json says so ("auto" would take 166 samples).
+  const CliResult big = s.run(
+      "frf case.toml --quiet --no-plots --out n512 --set hbm.time_samples=512 --set response.stability_samples=512");
   ASSERT_EQ(big.status, 0) << big.err;
   const auto k = nlohmann::json::parse(slurp(s.dir() / "n512" / "run.json"));
   EXPECT_EQ(k["frf_model"]["harmonic_indices"], nlohmann::json({1, 2, 3}));

@@ -850,6 +850,7 @@ TEST(CliContinuation, HillsMethodTakesTheSliderAsAStateAndAgreesWithTheShootingO
   EXPECT_EQ(st["method"].get<std::string>(), "hill");
   EXPECT_EQ(st["linearization"].get<std::string>(), "slider_state");
   EXPECT_FALSE(st.contains("hill"));
+  EXPECT_EQ(st["memory_samples"].get<int>(), 128);  // N: 2 x 128 damper positions fit
   EXPECT_EQ(st["unstable_points"].get<int>(), 0);
   const auto rows = csv_rows(slurp(s.dir() / "hill" / "frf.csv"));
   int ones = 0;
@@ -865,9 +866,10 @@ TEST(CliContinuation, HillsMethodTakesTheSliderAsAStateAndAgreesWithTheShootingO
   EXPECT_EQ(sa["hill"]["disagreements"].get<int>(), 0);
   EXPECT_FALSE(sa["hill"].contains("reason"));
 
-  // At N = 1024 the pencil (186 + 2 x 1024 wide) is above the size limit: Hill judges none of the
-  // shooting's points, and run.json says why.
-  const CliResult big = s.run("frf case.toml --threads 2 --out big --set hbm.time_samples=1024");
+  // At N = 1024 with the slider state at every sample the pencil (186 + 2 x 1024 wide) is above
+  // the size limit: Hill judges none of the shooting's points, and run.json says why.
+  const CliResult big =
+      s.run("frf case.toml --threads 2 --out big --set hbm.time_samples=1024 --set response.stability_samples=1024");
   ASSERT_EQ(big.status, 0) << big.err;
   const auto frf_big = frf_of(s, "big");
   const auto& sb = frf_big["stability"];

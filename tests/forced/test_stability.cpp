@@ -551,8 +551,9 @@ TEST(Shooting, PointsHillCallsUnstableWhereTheTimeIntegrationSettlesAreStable) {
 /// Hill's method with the slider as a state against the shooting at every 5th point of l's curve:
 /// the same verdict wherever the shooting judges, and (radius_tol > 0) the spectral radius within
 /// radius_tol. Returns the points judged; *old_disagree counts the harmonic balance
-/// linearization's verdicts that differ from the shooting's.
-int compare_with_shooting(const Lumped& l, double radius_tol, int* old_disagree) {
+/// linearization's verdicts that differ from the shooting's. samples: the slider state's time
+/// samples (0: the harmonic balance's N; contact_memory).
+int compare_with_shooting(const Lumped& l, double radius_tol, int* old_disagree, int samples = 0) {
   hbm::ContactEvaluator ev(l.options, l.model.pairs);
   ReducedEquations eq(*l.model.linear, ev);
   const FrequencyResponse r = trace_whole_range(l, eq);
@@ -561,7 +562,8 @@ int compare_with_shooting(const Lumped& l, double radius_tol, int* old_disagree)
   *old_disagree = 0;
   for (std::size_t i = 0; i < r.points.size(); i += 5) {
     const double f = r.points[i].lambda;
-    const ContactMemory memory = contact_memory(eq, r.points[i].x);
+    const ContactMemory memory = contact_memory(eq, r.points[i].x, samples);
+    EXPECT_EQ(static_cast<int>(memory.steps.front().size()), samples > 0 ? samples : l.options.n_time_samples);
     const FloquetResult hill =
         floquet_exponents(eq, r.points[i].x, f, ExponentSelection::symmetry, kMaxHillSize, kModeCutoff, &memory);
     EXPECT_TRUE(hill.available) << hill.reason;
@@ -589,6 +591,30 @@ TEST(Stability, WithTheSliderAsAStateHillGivesTheShootingsVerdictWhereTheHarmoni
   int old_disagree = 0;
   EXPECT_GE(compare_with_shooting(model_8(), kRadiusTol, &old_disagree), 35);
   EXPECT_GE(old_disagree, 4) << "dF/dW no longer disagrees with the shooting here: the test's premise is gone";
+}
+
+// The slider state sampled at N / 2 (response.stability_samples; ContactMemory::correction keeps
+// the harmonic balance's linearization at lambda = 0): on stress models 8 (N = 128, 64 samples)
+// and 105 (N = 64, 32 samples) every verdict the shooting gives is the same, as at N. The radius
+// is the coarser law's: on model 8 within 0.199 of the shooting's (0.061 at N; 0.417 at 32
+// samples, where 2H + 1 = 31), so kCoarseRadiusTol = 0.25.
+TEST(Stability, WithTheSliderStateSampledAtHalfTheHarmonicBalancesNHillKeepsTheShootingsVerdicts) {
+  constexpr double kCoarseRadiusTol = 0.25;
+  int old_disagree = 0;
+  EXPECT_GE(compare_with_shooting(model_8(), kCoarseRadiusTol, &old_disagree, 64), 35);
+  EXPECT_GE(compare_with_shooting(model_105(), 0.0, &old_disagree, 32), 40);
+}
+
+// The count of the slider state's samples (forced::memory_samples): what is asked for, within
+// 2H + 1 and N; automatic: N where the dampers' positions fit, else the most that fit.
+TEST(Stability, TheSliderStatesSamplesAreWhatIsAskedForWithin2HPlus1AndN) {
+  EXPECT_EQ(memory_samples(64, 128, 15, 2), 64);
+  EXPECT_EQ(memory_samples(16, 128, 15, 2), 31);                      // raised to 2H + 1
+  EXPECT_EQ(memory_samples(4096, 128, 15, 2), 128);                   // at most N
+  EXPECT_EQ(memory_samples(0, 128, 15, 2), 128);                      // 256 positions fit
+  EXPECT_EQ(memory_samples(0, 512, 5, 10), kMaxMemoryUnknowns / 10);  // the default sector: 100
+  EXPECT_EQ(memory_samples(0, 512, 60, 10), 121);                     // never below 2H + 1
+  EXPECT_EQ(memory_samples(0, 64, 5, 0), 64);                         // no damper
 }
 
 // Stress model 105 (quasi3d with separation, N = 64), where the curve closes on itself near
