@@ -76,8 +76,8 @@ constexpr int kMaxSliderStateSize = 1200;
 
 /// The damper positions (slider-state unknowns) the automatic memory sampling allows
 /// (memory_samples): kMaxSliderStateSize less room for the companion's unknowns (the default
-/// sector's families have 2 s = 198 at 80 Hz).
-constexpr int kMaxMemoryUnknowns = 1000;
+/// sector's families have 2 s = 154 at 80 Hz to 330 at 220 Hz, its modes below 2 (H + 1) w).
+constexpr int kMaxMemoryUnknowns = 800;
 
 /// The time samples of the slider state (response.stability_samples): `requested` (0: automatic)
 /// at least 2H + 1 and at most the harmonic balance's N; automatic: N where N x dampers (pairs x

@@ -200,14 +200,21 @@ std::vector<forced::FloquetResult> shooting_stability(
 void report_stability(nlohmann::json& s, const std::vector<forced::FloquetResult>& out,
                       const std::vector<std::string>& errors, const forced::FrequencyResponse& response,
                       const std::string& method) {
-  int unstable = 0, failed = 0, size = 0;
-  std::string failure;
+  int unstable = 0, failed = 0, size = 0, not_judged = 0;
+  std::string failure, not_judged_reason;
   for (std::size_t i = 0; i < out.size(); ++i) {
     if (!errors[i].empty()) {
       ++failed;
       failure = errors[i];
     }
-    if (!out[i].available) continue;
+    if (!out[i].available) {
+      // Not analysed for a reason of its own (a problem above the size limits at this point's
+      // frequency), or left out by the shooting's stride.
+      if (errors[i].empty() && !out[i].reason.empty()) {
+        if (not_judged++ == 0) not_judged_reason = out[i].reason;
+      }
+      continue;
+    }
     unstable += out[i].stable ? 0 : 1;
     size = std::max(size, out[i].hill_size);
   }
@@ -237,6 +244,8 @@ void report_stability(nlohmann::json& s, const std::vector<forced::FloquetResult
   s["unstable_points"] = unstable;
   s["failed_points"] = failed;
   if (failed > 0) s["failure"] = failure;
+  s["not_judged_points"] = not_judged;
+  if (not_judged > 0) s["not_judged_reason"] = not_judged_reason;
   s["changes"] = nlohmann::json::array();
   for (const auto& c : forced::stability_changes(out, freq, amp, response.piece))
     s["changes"].push_back({{"kind", forced::to_string(c.kind)},
@@ -248,7 +257,8 @@ void report_stability(nlohmann::json& s, const std::vector<forced::FloquetResult
                               : "shooting, " + std::to_string(s["state_size"].get<int>()) + " multipliers per point") +
             "): " + std::to_string(unstable) + " of " + std::to_string(out.size()) + " points unstable, " +
             std::to_string(s["changes"].size()) + " changes of stability" +
-            (failed ? ", " + std::to_string(failed) + " points not analysed" : ""));
+            (failed ? ", " + std::to_string(failed) + " points not analysed" : "") +
+            (not_judged ? ", " + std::to_string(not_judged) + " points not judged: " + not_judged_reason : ""));
 }
 
 /// The stability of every point and run.json's frf.stability, by response.stability_method:

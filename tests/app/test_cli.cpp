@@ -513,7 +513,7 @@ TEST(Cli, HillOnASectorJudgesEveryPointOverTheModesOfEveryHarmonicIndex) {
   EXPECT_EQ(m32["failed_points"].get<int>(), 0);
   // At N = 512 with the slider state at every sample the damper positions alone would make each
   // pencil 512 x 2 x 3 = 3072 wide, above the limit: refused before any further mode is computed,
-  // and run.json says so ("auto" would take 166 samples).
+  // and run.json says so ("auto" would take 133 samples).
   const CliResult big = s.run(
       "frf case.toml --quiet --no-plots --out n512 --set hbm.time_samples=512 --set response.stability_samples=512");
   ASSERT_EQ(big.status, 0) << big.err;

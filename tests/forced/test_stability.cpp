@@ -612,7 +612,7 @@ TEST(Stability, TheSliderStatesSamplesAreWhatIsAskedForWithin2HPlus1AndN) {
   EXPECT_EQ(memory_samples(16, 128, 15, 2), 31);                      // raised to 2H + 1
   EXPECT_EQ(memory_samples(4096, 128, 15, 2), 128);                   // at most N
   EXPECT_EQ(memory_samples(0, 128, 15, 2), 128);                      // 256 positions fit
-  EXPECT_EQ(memory_samples(0, 512, 5, 10), kMaxMemoryUnknowns / 10);  // the default sector: 100
+  EXPECT_EQ(memory_samples(0, 512, 5, 10), kMaxMemoryUnknowns / 10);  // the default sector: 80
   EXPECT_EQ(memory_samples(0, 512, 60, 10), 121);                     // never below 2H + 1
   EXPECT_EQ(memory_samples(0, 64, 5, 0), 64);                         // no damper
 }
