@@ -262,7 +262,8 @@ std::string sector_stability_refusal(const io::Case& c) {
          "\"hill\" judges every point over the sector's perturbation families, which needs the modes of every "
          "harmonic index 0..Nb/2 and, with friction, a pencil wider by the damper positions of the slider state "
          "per family (response.stability_samples: the default case's 700 points took 833 s on 2 threads, its "
-         "slider state at 80 of 512 samples, against 10 s for the rest of the run with its modes cached). On the coarse test sector its verdicts agree with the whole wheel's time integration (shooting in modal "
+         "slider state at 80 of 512 samples, against 10 s for the rest of the run with its modes cached). On the "
+         "coarse test sector its verdicts agree with the whole wheel's time integration (shooting in modal "
          "coordinates) wherever the multipliers are clearly off 1, and both find the travelling wave unstable over "
          "most of its friction range";
 }
