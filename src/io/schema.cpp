@@ -585,8 +585,9 @@ Schema declare() {
       .within(1e5, End::closed, 1e12, End::closed);
   d.integer("response.stability_samples", at(&Case::response, &ResponseSection::stability_samples), 0, "",
             "hill with friction: time samples of the slider state (damper positions per pair and tangential "
-            "direction), at most hbm.time_samples; auto = hbm.time_samples where the damper positions fit within "
-            "800, else the most that fit (the default sector: 80 of 512); at lambda = 0 the problem is the "
+            "direction), at most hbm.time_samples; auto = hbm.time_samples for a lumped model; for an FE sector "
+            "hbm.time_samples where the damper positions fit within 800, else the most that fit (the default "
+            "sector: 80 of 512); at lambda = 0 the problem is the "
             "harmonic balance's linearization at any count; the verdicts' error against it: docs/physics.md section 9")
       .range(3, 65536)
       .or_word({"auto", "\"auto\" or an integer >= 3", [](Case& c) { c.response.stability_samples = 0; },

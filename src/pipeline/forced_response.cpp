@@ -283,9 +283,14 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
   s["requested"] = io::to_string(c.response.stability_method);
   // With friction Hill's method takes the slider as a state (forced::ContactMemory).
   s["linearization"] = friction ? "slider_state" : "harmonic_balance";
-  // The slider state's time samples (response.stability_samples; docs/physics.md section 9).
+  // The slider state's time samples (response.stability_samples; docs/physics.md section 9):
+  // "auto" samples a lumped model's at N, as its harmonic balance (its pencils judged where they
+  // fit, as the shooting's comparison has always been), and reduces an FE sector's.
   const hbm::ContactEvaluatorOptions& eo = evaluator.options();
-  const int samples = forced::memory_samples(c.response.stability_samples, eo.n_time_samples, eo.n_harmonics,
+  const int requested = c.response.stability_samples > 0 || c.structure.type == io::StructureType::sector
+                            ? c.response.stability_samples
+                            : eo.n_time_samples;
+  const int samples = forced::memory_samples(requested, eo.n_time_samples, eo.n_harmonics,
                                              static_cast<int>(pairs.size()) * (law == contact::Model::one_d ? 1 : 2));
   if (friction && law != contact::Model::one_d_exact) s["memory_samples"] = samples;
   if (!shooting) {
