@@ -21,6 +21,8 @@ std::string to_string(TangentialUpdate update) {
 
 int n_directions(Model model) { return (model == Model::one_d || model == Model::one_d_exact) ? 1 : 3; }
 
+int n_tangential_directions(Model model) { return n_directions(model) == 1 ? 1 : 2; }
+
 namespace {
 
 std::string num(double v) {

@@ -43,6 +43,8 @@ std::string to_string(TangentialUpdate update);  ///< "radial_return", "exact_li
 
 /// Directions a model uses: 3 (x, y, z) or 1 (x) for the 1d models.
 int n_directions(Model model);
+/// Tangential directions of a model's friction slider: 1 for the 1d models, 2 otherwise.
+int n_tangential_directions(Model model);
 
 /// Physical parameters of one pair. SI units.
 struct PairParameters {

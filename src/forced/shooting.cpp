@@ -185,7 +185,7 @@ ShootingResult shooting_floquet(const LumpedSystem& s, const std::vector<contact
   std::vector<std::string> errors;
   if (!o.validate(&errors)) throw std::invalid_argument("shooting options: " + errors.front());
   const Eigen::Index n = s.mass.rows();
-  const Eigen::Index dirs = contact::n_directions(model) == 1 ? 1 : 2;
+  const Eigen::Index dirs = contact::n_tangential_directions(model);
   if (!s.consistent(static_cast<Eigen::Index>(pairs.size())) || u0.size() != n || v0.size() != n ||
       sliders0.size() != dirs * static_cast<Eigen::Index>(pairs.size()))
     throw std::invalid_argument("shooting: inconsistent sizes of M, C, K, B, f and the state");

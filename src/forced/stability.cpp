@@ -118,7 +118,7 @@ SliderPencil slider_state_pencil(const Eigen::MatrixXcd& a0, const Eigen::Matrix
                                  const Eigen::MatrixXcd& correction) {
   const Complex i1(0.0, 1.0);
   const int np = static_cast<int>(memory.pairs.size());
-  const int nt = memory.model == contact::Model::one_d ? 1 : 2;
+  const int nt = contact::n_tangential_directions(memory.model);
   const int n = static_cast<int>(memory.steps.front().size());
   const Eigen::Index s = a0.rows(), ne = phi.rows(), ns = static_cast<Eigen::Index>(np) * nt * n;
   const auto wi = [&](int k, int p, int d) { return static_cast<Eigen::Index>(k + h) * c + 3 * p + d; };
@@ -380,7 +380,7 @@ FloquetResult floquet_exponents(const frf::LinearPart& linear, const hbm::Harmon
   }
   if (memory != nullptr) {
     const int slider_unknowns = static_cast<int>(memory->pairs.size()) *
-                                (memory->model == contact::Model::one_d ? 1 : 2) *
+                                contact::n_tangential_directions(memory->model) *
                                 static_cast<int>(memory->steps.front().size());
     out.hill_size += slider_unknowns;
     if (out.hill_size > kMaxSliderStateSize) {

@@ -211,7 +211,7 @@ bool sector_hill(const io::Case& c) {
 }
 
 /// The friction slider's directions: 1 for the 1d laws, 2 otherwise.
-int tangential_directions(const io::Case& c) { return contact::n_directions(c.contact.model) == 1 ? 1 : 2; }
+int tangential_directions(const io::Case& c) { return contact::n_tangential_directions(c.contact.model); }
 
 /// With friction the slider state adds (memory samples) x (tangential directions) x (contact
 /// elements) to each family's pencil (forced::memory_samples). Where the case fixes N, H and the

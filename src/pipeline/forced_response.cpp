@@ -291,7 +291,7 @@ std::vector<forced::FloquetResult> analyse_stability(nlohmann::json& j, const fo
                             ? c.response.stability_samples
                             : eo.n_time_samples;
   const int samples = forced::memory_samples(requested, eo.n_time_samples, eo.n_harmonics,
-                                             static_cast<int>(pairs.size()) * (law == contact::Model::one_d ? 1 : 2));
+                                             static_cast<int>(pairs.size()) * contact::n_tangential_directions(law));
   if (friction && law != contact::Model::one_d_exact) s["memory_samples"] = samples;
   if (!shooting) {
     std::vector<forced::FloquetResult> hill = hill_stability(response, equations, threads, samples, errors);
